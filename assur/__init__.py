@@ -1,0 +1,12 @@
+"""assur: the library of Assur-group solvers (position, analogs, reactions), one kind per module.
+
+See :mod:`assur.base` for the group protocol every kind implements.
+"""
+
+from .base import CANNOT_ASSEMBLE, OK, SINGULAR, Group, PrismaticJoint, RevoluteJoint
+from .registry import GROUP_KINDS, group_kind, register, solver_for
+
+__all__ = [
+    "Group", "RevoluteJoint", "PrismaticJoint", "GROUP_KINDS", "group_kind", "register",
+    "solver_for", "OK", "CANNOT_ASSEMBLE", "SINGULAR",
+]

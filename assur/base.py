@@ -1,0 +1,383 @@
+"""The group protocol and the constraint machinery every group kind shares (METHOD section 3).
+
+Shapes and conventions
+----------------------
+Everything is vectorised over a leading positions axis of length N.
+
+- A *pose* of link k is an array ``(N, 3)``: ``x, y`` of the link's local origin (m) and
+  ``theta``, the angle of its local x axis (rad, CCW from global +x). Poses travel in a
+  ``dict`` link name -> array. First / second analogs (derivatives with respect to the input
+  angle phi) use the same layout.
+- Joints carry the local geometry of one kinematic pair (:class:`RevoluteJoint`,
+  :class:`PrismaticJoint`). Each contributes two constraint equations ``Phi = 0``.
+
+The plug-in contract of a group kind
+------------------------------------
+A kind subclasses :class:`Group` and fills in
+
+- ``kind`` (registry name), ``branches`` (``(1, -1)`` when the closed form has two assembly
+  branches, ``(1,)`` otherwise);
+- ``_bind(links, joints, known)`` (classmethod): return an instance when this kind solves the
+  group with these joints (roles of guide and slider included) or ``None``;
+- ``_position(poses, branch)``: closed-form poses of the group's links from the known poses,
+  returning ``(new_poses, assembled)`` where ``assembled`` is a boolean mask; positions that
+  cannot be assembled may hold anything (they are replaced by NaN).
+
+The public template methods :meth:`Group.position`, :meth:`Group.analogs` and
+:meth:`Group.reactions` add the shared checks (closure, singularity relative to the mechanism
+size) and the shared linear algebra (constraint Jacobian for analogs, its transpose for
+reactions). Status codes per position: ``OK = 0``, ``CANNOT_ASSEMBLE = -1``, ``SINGULAR = -2``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import ClassVar, Mapping, Sequence
+
+import numpy as np
+
+__all__ = [
+    "OK",
+    "CANNOT_ASSEMBLE",
+    "SINGULAR",
+    "RevoluteJoint",
+    "PrismaticJoint",
+    "Group",
+    "GroupPosition",
+    "rotate",
+    "perp",
+    "global_point",
+    "point_analogs",
+]
+
+OK, CANNOT_ASSEMBLE, SINGULAR = 0, -1, -2
+
+#: relative closure residual above which a closed-form position counts as not assembled
+CLOSURE_TOL = 1e-9
+#: reciprocal condition number of the scaled group Jacobian below which a position is singular
+SINGULAR_TOL = 1e-9
+
+Poses = Mapping[str, np.ndarray]
+
+
+# ----------------------------------------------------------------------------------------------
+# small vectorised geometry
+# ----------------------------------------------------------------------------------------------
+
+
+def rotate(theta: np.ndarray, p) -> np.ndarray:
+    """``Rot(theta) @ p`` for angles ``(N,)`` and a vector ``(2,)`` or ``(N, 2)`` -> ``(N, 2)``."""
+    c, s = np.cos(theta), np.sin(theta)
+    p = np.asarray(p, dtype=float)
+    px, py = p[..., 0], p[..., 1]
+    return np.stack([c * px - s * py, s * px + c * py], axis=-1)
+
+
+def perp(v: np.ndarray) -> np.ndarray:
+    """``E @ v``: rotate vectors ``(..., 2)`` by +90 degrees."""
+    return np.stack([-v[..., 1], v[..., 0]], axis=-1)
+
+
+def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """z component of ``a x b`` for vectors ``(..., 2)``."""
+    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+
+
+def dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return np.einsum("...i,...i->...", a, b)
+
+
+def angle_of(v: np.ndarray) -> np.ndarray:
+    """Direction angle (rad) of vectors ``(..., 2)``."""
+    return np.arctan2(v[..., 1], v[..., 0])
+
+
+def global_point(pose: np.ndarray, local) -> np.ndarray:
+    """Global position ``(N, 2)`` of a point with local coordinates ``local`` on a link."""
+    return pose[:, :2] + rotate(pose[:, 2], local)
+
+
+def point_analogs(pose, first, second, local):
+    """First and second analogs ``(N, 2)`` of a point fixed in a link (METHOD section 3)."""
+    rho = rotate(pose[:, 2], local)
+    d1 = None if first is None else first[:, :2] + perp(rho) * first[:, 2:3]
+    d2 = None
+    if second is not None:
+        d2 = second[:, :2] + perp(rho) * second[:, 2:3] - rho * first[:, 2:3] ** 2
+    return d1, d2
+
+
+# ----------------------------------------------------------------------------------------------
+# joints: the two constraint equations of a pair, their Jacobian and quadratic terms
+# ----------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class RevoluteJoint:
+    """``r_a + Rot(theta_a) p_a - r_b - Rot(theta_b) p_b = 0``; ``lambda`` = force of b on a."""
+
+    name: str
+    a: str
+    b: str
+    pa: tuple[float, float]
+    pb: tuple[float, float]
+    kind: ClassVar[str] = "R"
+
+    def local(self, link: str):
+        """(local point on ``link``, other link, local point on the other link)."""
+        return (self.pa, self.b, self.pb) if link == self.a else (self.pb, self.a, self.pa)
+
+    def residual(self, poses: Poses) -> np.ndarray:
+        return global_point(poses[self.a], self.pa) - global_point(poses[self.b], self.pb)
+
+    def jacobian(self, poses: Poses) -> dict[str, np.ndarray]:
+        out = {}
+        for link, p, sign in ((self.a, self.pa, 1.0), (self.b, self.pb, -1.0)):
+            rho = rotate(poses[link][:, 2], p)
+            block = np.zeros((len(rho), 2, 3))
+            block[:, 0, 0] = block[:, 1, 1] = sign
+            block[:, :, 2] = sign * perp(rho)
+            out[link] = block
+        return out
+
+    def quadratic(self, poses: Poses, first: Poses) -> np.ndarray:
+        """Right-hand side terms of the second-analog system (gamma of METHOD section 3)."""
+        ta, tb = first[self.a][:, 2:3], first[self.b][:, 2:3]
+        return ta**2 * rotate(poses[self.a][:, 2], self.pa) - tb**2 * rotate(poses[self.b][:, 2], self.pb)
+
+    def row_scale(self, size: float) -> np.ndarray:
+        return np.array([1.0, 1.0])
+
+
+@dataclass(frozen=True)
+class PrismaticJoint:
+    """Slider b's point ``p`` on guide line (``g``, ``u``) of link a; ``theta_b - theta_a = beta``.
+
+    Equations: ``n . d = 0`` and ``theta_b - theta_a - beta = 0`` with ``u = Rot(theta_a) u_local``,
+    ``n = E u``, ``d = r_b + Rot(theta_b) p - r_a - Rot(theta_a) g``. The slide is ``s = u . d``.
+    ``lambda[0]`` is the normal force of the guide on the slider along ``n``; ``lambda[1]`` the
+    moment of the guide on the slider about the slider point ``p``.
+    """
+
+    name: str
+    a: str
+    b: str
+    g: tuple[float, float]
+    u: tuple[float, float]
+    p: tuple[float, float]
+    beta: float
+    kind: ClassVar[str] = "P"
+
+    def frame(self, poses: Poses):
+        """(u, n, ga, pb, d) in global coordinates, each ``(N, 2)``."""
+        ta, tb = poses[self.a][:, 2], poses[self.b][:, 2]
+        u = rotate(ta, self.u)
+        ga, pb = rotate(ta, self.g), rotate(tb, self.p)
+        d = poses[self.b][:, :2] + pb - poses[self.a][:, :2] - ga
+        return u, perp(u), ga, pb, d
+
+    def residual(self, poses: Poses) -> np.ndarray:
+        u, n, _, _, d = self.frame(poses)
+        angle = poses[self.b][:, 2] - poses[self.a][:, 2] - self.beta
+        angle = (angle + np.pi) % (2 * np.pi) - np.pi
+        return np.stack([dot(n, d), angle], axis=-1)
+
+    def slide(self, poses: Poses, first: Poses | None = None, second: Poses | None = None):
+        """Slide ``s = u . d`` and its first / second analogs (``None`` when not asked)."""
+        u, n, ga, pb, d = self.frame(poses)
+        s = dot(u, d)
+        if first is None:
+            return s, None, None
+        ta1 = first[self.a][:, 2]
+        d1 = first[self.b][:, :2] + perp(pb) * first[self.b][:, 2:3] - first[self.a][:, :2] - perp(ga) * ta1[:, None]
+        s1 = ta1 * dot(n, d) + dot(u, d1)
+        if second is None:
+            return s, s1, None
+        ta2, tb1 = second[self.a][:, 2], first[self.b][:, 2:3]
+        d2 = (second[self.b][:, :2] + perp(pb) * second[self.b][:, 2:3] - pb * tb1**2
+              - second[self.a][:, :2] - perp(ga) * ta2[:, None] + ga * ta1[:, None] ** 2)
+        s2 = ta2 * dot(n, d) - ta1**2 * dot(u, d) + 2 * ta1 * dot(n, d1) + dot(u, d2)
+        return s, s1, s2
+
+    def jacobian(self, poses: Poses) -> dict[str, np.ndarray]:
+        u, n, ga, pb, d = self.frame(poses)
+        N = len(u)
+        ja, jb = np.zeros((N, 2, 3)), np.zeros((N, 2, 3))
+        ja[:, 0, :2] = -n
+        ja[:, 0, 2] = -dot(u, d) - dot(n, perp(ga))
+        ja[:, 1, 2] = -1.0
+        jb[:, 0, :2] = n
+        jb[:, 0, 2] = dot(n, perp(pb))
+        jb[:, 1, 2] = 1.0
+        return {self.a: ja, self.b: jb}
+
+    def quadratic(self, poses: Poses, first: Poses) -> np.ndarray:
+        u, n, ga, pb, d = self.frame(poses)
+        ta, tb = first[self.a][:, 2:3], first[self.b][:, 2:3]
+        d1 = first[self.b][:, :2] + perp(pb) * tb - first[self.a][:, :2] - perp(ga) * ta
+        ta = ta[:, 0]
+        rhs = dot(n, d) * ta**2 + 2 * ta * dot(u, d1) + dot(n, pb * tb**2 - ga * ta[:, None] ** 2)
+        return np.stack([rhs, np.zeros_like(rhs)], axis=-1)
+
+    def row_scale(self, size: float) -> np.ndarray:
+        return np.array([1.0, size])
+
+
+Joint = RevoluteJoint | PrismaticJoint
+
+
+# ----------------------------------------------------------------------------------------------
+# the group protocol
+# ----------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class GroupPosition:
+    """Result of :meth:`Group.position`: poses of the group's links and a status per position."""
+
+    poses: dict[str, np.ndarray]
+    status: np.ndarray
+    jacobian_sign: np.ndarray  # sign of det of the group Jacobian (0 where not assembled)
+
+
+class Group:
+    """Base class of Assur group solvers (see the module docstring for the plug-in contract).
+
+    Attributes
+    ----------
+    links : tuple of str
+        The group's links in the kind's order (e.g. RRP: the link with the external R first).
+    joints : tuple of Joint
+        Every pair of the group (internal and external).
+    size : float
+        Characteristic length of the mechanism (m), for scale-free tolerances.
+    """
+
+    kind: ClassVar[str] = ""
+    group_class: ClassVar[str] = "II"
+    branches: ClassVar[tuple[int, ...]] = (1,)
+
+    def __init__(self, links: Sequence[str], joints: Sequence[Joint], size: float = 1.0):
+        self.links = tuple(links)
+        self.joints = tuple(joints)
+        self.size = float(size)
+        self.known_links = tuple(sorted(({j.a for j in joints} | {j.b for j in joints}) - set(links)))
+
+    # -- binding -------------------------------------------------------------------------------
+    @classmethod
+    def bind(cls, links: Sequence[str], joints: Sequence[Joint], known: set[str], size: float = 1.0):
+        """An instance of this kind for the group, or ``None`` when this kind does not solve it."""
+        return cls._bind(tuple(links), tuple(joints), set(known), size)
+
+    @classmethod
+    def _bind(cls, links, joints, known, size):  # pragma: no cover - abstract hook
+        raise NotImplementedError
+
+    def __repr__(self) -> str:
+        return f"{self.group_class}-{self.kind}({','.join(self.links)})"
+
+    # -- position ------------------------------------------------------------------------------
+    def position(self, poses: Poses, branch: int = 1) -> GroupPosition:
+        """Poses of the group's links given the known ``poses``; checks closure and singularity."""
+        if branch not in self.branches:
+            raise ValueError(f"{self!r}: branch must be one of {self.branches}, got {branch!r}")
+        new, assembled = self._position(poses, branch)
+        merged = {**poses, **new}
+        residual = self.residual(merged)
+        closure = np.max(np.abs(residual), axis=1) if residual.size else np.zeros(len(assembled))
+        assembled = assembled & np.isfinite(closure) & (closure <= CLOSURE_TOL * self.size)
+        status = np.where(assembled, OK, CANNOT_ASSEMBLE)
+        sign = np.zeros(len(status))
+        if assembled.any():
+            rcond, det_sign = self._conditioning({k: v[assembled] for k, v in merged.items()})
+            status[np.flatnonzero(assembled)[rcond < SINGULAR_TOL]] = SINGULAR
+            sign[assembled] = det_sign
+        for k in new:
+            new[k] = np.where(assembled[:, None], new[k], np.nan)
+        return GroupPosition(new, status, sign)
+
+    def _position(self, poses: Poses, branch: int):  # pragma: no cover - abstract hook
+        raise NotImplementedError
+
+    # -- the constraint system -----------------------------------------------------------------
+    def residual(self, poses: Poses) -> np.ndarray:
+        """Stacked constraint residuals ``(N, 2 * n_joints)`` (prismatic angle rows scaled to m)."""
+        return np.concatenate([j.residual(poses) * j.row_scale(self.size) for j in self.joints], axis=1)
+
+    def jacobians(self, poses: Poses) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+        """``Phi_q`` ``(N, m, m)`` for the group's links and ``Phi_k`` blocks ``(N, m, 3)``."""
+        N = len(next(iter(poses.values())))
+        m = 2 * len(self.joints)
+        col = {link: 3 * i for i, link in enumerate(self.links)}
+        phi_q = np.zeros((N, m, 3 * len(self.links)))
+        phi_k = {k: np.zeros((N, m, 3)) for k in self.known_links}
+        for r, joint in enumerate(self.joints):
+            for link, block in joint.jacobian(poses).items():
+                if link in col:
+                    phi_q[:, 2 * r : 2 * r + 2, col[link] : col[link] + 3] += block
+                else:
+                    phi_k[link][:, 2 * r : 2 * r + 2, :] += block
+        return phi_q, phi_k
+
+    def _conditioning(self, poses: Poses):
+        """Reciprocal condition number and det sign of the scale-free group Jacobian."""
+        phi_q, _ = self.jacobians(poses)
+        rows = np.concatenate([j.row_scale(self.size) for j in self.joints])
+        cols = np.tile([1.0, 1.0, 1.0 / self.size], len(self.links))
+        scaled = phi_q * rows[None, :, None] * cols[None, None, :]
+        sv = np.linalg.svd(scaled, compute_uv=False)
+        rcond = sv[:, -1] / sv[:, 0]
+        return rcond, np.sign(np.linalg.det(scaled))
+
+    # -- analogs -------------------------------------------------------------------------------
+    def analogs(self, poses: Poses, first: Poses, second: Poses | None = None):
+        """First (and, if ``second`` of the known links is given, second) analogs of the group.
+
+        Solves ``Phi_q q' = -Phi_k q'_k`` and ``Phi_q q'' = -Phi_k q''_k + gamma`` (METHOD 3).
+        Positions where a pose is NaN give NaN.
+        """
+        phi_q, phi_k = self.jacobians(poses)
+        ok = np.all(np.isfinite(phi_q), axis=(1, 2))
+        phi_q[~ok] = np.eye(phi_q.shape[1])
+        rhs1 = -sum(np.einsum("nij,nj->ni", phi_k[k], first[k]) for k in self.known_links)
+        q1 = np.linalg.solve(phi_q, rhs1[..., None])[..., 0]
+        q1[~ok] = np.nan
+        d1 = self._split(q1)
+        if second is None:
+            return d1, None
+        all_first = {**first, **d1}
+        gamma = np.concatenate([j.quadratic(poses, all_first) for j in self.joints], axis=1)
+        rhs2 = gamma - sum(np.einsum("nij,nj->ni", phi_k[k], second[k]) for k in self.known_links)
+        q2 = np.linalg.solve(phi_q, rhs2[..., None])[..., 0]
+        q2[~ok] = np.nan
+        return d1, self._split(q2)
+
+    def _split(self, q: np.ndarray) -> dict[str, np.ndarray]:
+        return {link: q[:, 3 * i : 3 * i + 3] for i, link in enumerate(self.links)}
+
+    # -- reactions -----------------------------------------------------------------------------
+    def reactions(self, poses: Poses, loads: Poses):
+        """Joint reactions from the equilibrium of the group's links.
+
+        Parameters
+        ----------
+        poses : dict
+            Poses of the group's and known links.
+        loads : dict
+            Generalized applied loads ``(N, 3)`` on each of the group's links: ``Fx, Fy`` (N)
+            and the moment about the link's local origin (N m), inertia loads included.
+
+        Returns
+        -------
+        multipliers : dict of joint name -> ``(N, 2)``
+            For a revolute joint the force of link b on link a; for a prismatic joint the normal
+            force of the guide on the slider and its moment about the slider point.
+        transmitted : dict of known link -> ``(N, 3)``
+            Generalized loads the group puts on each known link through its external joints.
+        """
+        phi_q, phi_k = self.jacobians(poses)
+        q = np.concatenate([loads[link] for link in self.links], axis=1)
+        lam = np.linalg.solve(np.transpose(phi_q, (0, 2, 1)), -q[..., None])[..., 0]
+        multipliers = {j.name: lam[:, 2 * r : 2 * r + 2] for r, j in enumerate(self.joints)}
+        transmitted = {k: np.einsum("nji,nj->ni", phi_k[k], lam) for k in self.known_links}
+        return multipliers, transmitted

@@ -1,0 +1,21 @@
+"""linkage: a graph-based generic planar linkage solver.
+
+A mechanism is a graph of links and kinematic pairs (:mod:`linkage.model`), declared in a
+scheme file (:mod:`linkage.scheme`) or in Python; it is decomposed into Assur groups
+(:mod:`linkage.structure`) whose solvers (package :mod:`assur`) give positions and exact
+transfer functions (:mod:`linkage.kinematics`).
+"""
+
+from .errors import AssemblyError, LinkageError, SchemeError, StructureError
+from .extremes import extreme_positions, table_angles
+from .kinematics import Motion, analyze, structure_of
+from .model import Mechanism, MechanismBuilder
+from .scheme import dumps, load, loads, save, shipped_schemes
+from .structure import decompose, mobility
+
+__all__ = [
+    "AssemblyError", "LinkageError", "SchemeError", "StructureError", "Mechanism",
+    "MechanismBuilder", "Motion", "analyze", "decompose", "dumps", "extreme_positions", "load",
+    "loads", "mobility", "save", "shipped_schemes", "structure_of", "table_angles",
+]
+__version__ = "0.1.0"

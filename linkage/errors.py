@@ -1,0 +1,48 @@
+"""The exception family of the library.
+
+``LinkageError`` is the root; every error the library raises on purpose is one of:
+
+- :class:`SchemeError` -- a mechanism is declared wrongly (bad file, unknown link, bad value);
+- :class:`StructureError` -- the mechanism's structure is wrong (mobility, not decomposable);
+- :class:`AssemblyError` -- a group cannot be assembled at some input angles.
+"""
+
+from __future__ import annotations
+
+__all__ = ["LinkageError", "SchemeError", "StructureError", "AssemblyError"]
+
+
+class LinkageError(Exception):
+    """Root of every error raised on purpose by ``linkage`` and ``assur``."""
+
+
+class SchemeError(LinkageError, ValueError):
+    """A mechanism declaration is invalid.
+
+    Parameters
+    ----------
+    problems : list of str
+        Every problem found, each naming the file, the entry and the value.
+    """
+
+    def __init__(self, problems: list[str] | str):
+        self.problems = [problems] if isinstance(problems, str) else list(problems)
+        super().__init__("\n".join(self.problems))
+
+
+class StructureError(LinkageError):
+    """Mobility does not match the inputs, or the graph cannot be decomposed."""
+
+
+class AssemblyError(LinkageError):
+    """A group cannot be assembled (or is singular) at some input angles.
+
+    Attributes
+    ----------
+    angles_deg : numpy.ndarray
+        The offending input angles in degrees.
+    """
+
+    def __init__(self, message: str, angles_deg=()):
+        self.angles_deg = angles_deg
+        super().__init__(message)

@@ -1,0 +1,134 @@
+"""Extreme positions of an output coordinate and the input angles of position tables.
+
+An extreme position is a root of the output's first analog ``q'(phi) = 0`` (METHOD section 7),
+found by bracketing on a sweep and refining with Brent's method to ~1e-13 rad.
+
+>>> import math, linkage
+>>> ext = linkage.extreme_positions(linkage.load("slider_crank"), "B.x")
+>>> round(math.degrees(ext.phi_max), 3)
+2.579
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import brentq
+
+from .kinematics import analyze
+from .model import Mechanism
+
+__all__ = ["Extremes", "extreme_positions", "table_angles"]
+
+
+@dataclass(frozen=True)
+class Extremes:
+    """Extreme positions of one output quantity.
+
+    Attributes
+    ----------
+    quantity : str
+    phi_max, phi_min : float
+        Input angles (rad, in [0, 2 pi)) where the quantity is largest / smallest.
+    value_max, value_min : float
+        The quantity there (m or rad).
+    roots : ndarray
+        Every root of the first analog found in [0, 2 pi), sorted.
+    """
+
+    quantity: str
+    phi_max: float
+    phi_min: float
+    value_max: float
+    value_min: float
+    roots: np.ndarray
+
+    @property
+    def stroke(self) -> float:
+        """``value_max - value_min``."""
+        return self.value_max - self.value_min
+
+
+def _output_quantity(mech: Mechanism, quantity: str | None) -> str:
+    if quantity is not None:
+        return quantity
+    if mech.output is None:
+        raise ValueError(f"mechanism '{mech.name}' declares no output: name the quantity (e.g. 'B.x')")
+    return mech.output.quantity
+
+
+def extreme_positions(mech: Mechanism, quantity: str | None = None, *, samples: int = 720,
+                      xtol: float = 1e-14) -> Extremes:
+    """Find the extreme positions of ``quantity`` (default: the mechanism's declared output).
+
+    Parameters
+    ----------
+    mech : Mechanism
+    quantity : str, optional
+        ``"P.x"``, ``"P.y"``, ``"L.theta"`` or ``"K.s"``.
+    samples : int
+        Size of the bracketing sweep over one revolution.
+    xtol : float
+        Absolute tolerance of the roots, rad.
+
+    Raises
+    ------
+    ValueError
+        When the quantity has no extreme position over a revolution (it is monotonic or constant).
+    """
+    quantity = _output_quantity(mech, quantity)
+
+    def derivative(phi: float) -> float:
+        return analyze(mech, [phi], order=1, outputs=[quantity]).quantity(quantity)[1][0]
+
+    grid = np.linspace(0.0, 2 * np.pi, samples + 1)
+    motion = analyze(mech, grid, order=1, outputs=[quantity], on_failure="mask")
+    d1 = motion.quantity(quantity)[1]
+    roots = []
+    for i in range(samples):
+        a, b = d1[i], d1[i + 1]
+        if not (np.isfinite(a) and np.isfinite(b)):
+            continue
+        if a == 0.0:
+            roots.append(grid[i])
+        elif a * b < 0:
+            roots.append(brentq(derivative, grid[i], grid[i + 1], xtol=xtol, rtol=4 * np.finfo(float).eps))
+    if not roots:
+        raise ValueError(f"'{quantity}' of mechanism '{mech.name}' has no extreme position: its first "
+                         "analog does not change sign over a revolution")
+    roots = np.unique(np.mod(roots, 2 * np.pi))
+    values = analyze(mech, roots, order=0, outputs=[quantity]).quantity(quantity)[0]
+    i_max, i_min = int(np.argmax(values)), int(np.argmin(values))
+    return Extremes(quantity, float(roots[i_max]), float(roots[i_min]), float(values[i_max]),
+                    float(values[i_min]), roots)
+
+
+def table_angles(mech: Mechanism, n: int = 12, start: str | float = "extreme", direction: int = 1,
+                 quantity: str | None = None) -> np.ndarray:
+    """Input angles ``phi_i = phi0 + direction (i - 1) 2 pi / n``, i = 1..n+1 (METHOD section 1).
+
+    Parameters
+    ----------
+    n : int
+        Number of equal steps per revolution.
+    start : "extreme", "max", "min" or float
+        ``"extreme"``: the extreme position of the output that the mechanism declares as the start
+        (``output.start``); ``"max"`` / ``"min"``: that extreme of the output; a float: phi0 in
+        degrees.
+    direction : {1, -1}
+        Sign of the input angular velocity (the order of positions).
+    """
+    if n < 1:
+        raise ValueError(f"the number of positions must be >= 1, got {n}")
+    if direction not in (1, -1):
+        raise ValueError(f"direction must be +1 or -1, got {direction!r}")
+    if isinstance(start, str):
+        if start not in ("extreme", "max", "min"):
+            raise ValueError(f"start must be 'extreme', 'max', 'min' or an angle in deg, got {start!r}")
+        which = start if start != "extreme" else (mech.output.start if mech.output else "max")
+        ext = extreme_positions(mech, quantity)
+        phi0 = ext.phi_max if which == "max" else ext.phi_min
+    else:
+        phi0 = np.radians(float(start))
+    return phi0 + direction * np.arange(n + 1) * 2 * np.pi / n

@@ -1,0 +1,408 @@
+"""Kinematic analysis: run the Assur groups in order over a batch of input angles.
+
+>>> import numpy as np, linkage
+>>> mech = linkage.load("slider_crank")
+>>> motion = linkage.analyze(mech, np.radians([0.0, 90.0]))
+>>> motion.point("B").shape
+(2, 2)
+
+Results are exact: positions by each group's closed form, first and second transfer functions
+(analogs, derivatives with respect to the input angle phi) from the group constraint Jacobians
+(METHOD section 3); real velocities and accelerations follow as ``q' omega`` and
+``q'' omega^2 + q' eps``.
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass, field
+from typing import Iterable, Literal
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from assur.base import CANNOT_ASSEMBLE, OK, SINGULAR, global_point, perp, point_analogs, rotate
+
+from .errors import AssemblyError, SchemeError, StructureError
+from .model import Mechanism, Prismatic
+from .structure import Structure, decompose, joint_of
+
+__all__ = ["Motion", "analyze", "structure_of", "assembly_branches", "BranchWarning", "parse_quantity"]
+
+#: number of input angles of the sweep that resolves readable assembly conditions into branches
+BRANCH_SWEEP = 360
+
+
+class BranchWarning(UserWarning):
+    """A group changes assembly mode between analysed positions (it passes a singular position)."""
+
+
+def structure_of(mech: Mechanism) -> Structure:
+    """The (cached) decomposition of ``mech``."""
+    cache = _cache(mech)
+    if "structure" not in cache:
+        cache["structure"] = decompose(mech)
+    return cache["structure"]
+
+
+def _cache(mech: Mechanism) -> dict:
+    return mech.__dict__.setdefault("_analysis_cache", {})
+
+
+# ----------------------------------------------------------------------------------------------
+# the result
+# ----------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Motion:
+    """Kinematics of a mechanism over N input angles.
+
+    Attributes
+    ----------
+    phi : ndarray, shape (N,)
+        Input angles, rad.
+    poses, first, second : dict of link -> ndarray (N, 3)
+        Poses ``(x, y, theta)`` and their first / second analogs (``None`` when not computed).
+    status : ndarray of int, shape (N,)
+        0 ok, -1 cannot be assembled, -2 singular (analogs unbounded; they are NaN there).
+    omega, eps : ndarray (N,) or None
+        Input angular velocity (rad/s) and acceleration (rad/s^2) for real velocities.
+    """
+
+    mechanism: Mechanism
+    structure: Structure
+    phi: np.ndarray
+    poses: dict[str, np.ndarray]
+    first: dict[str, np.ndarray] | None
+    second: dict[str, np.ndarray] | None
+    status: np.ndarray
+    omega: np.ndarray | None = None
+    eps: np.ndarray | None = None
+    joints: dict = field(default_factory=dict, repr=False)
+
+    @property
+    def success(self) -> np.ndarray:
+        return self.status == OK
+
+    # -- points, links, slides -----------------------------------------------------------------
+    def point(self, name: str) -> np.ndarray:
+        """Global position ``(N, 2)`` of a named point, m."""
+        link, local = self._point(name)
+        return global_point(self.poses[link], local)
+
+    def point_analogs(self, name: str) -> tuple[np.ndarray, np.ndarray | None]:
+        """First and second analogs ``(N, 2)`` of a named point, m/rad and m/rad^2."""
+        link, local = self._point(name)
+        self._need(1)
+        return point_analogs(self.poses[link], self.first[link], self.second and self.second[link], local)
+
+    def _point(self, name: str):
+        link = self.mechanism.point_link(name)
+        if link not in self.poses:
+            raise ValueError(f"point '{name}' (link '{link}') was not among the requested outputs")
+        return link, self.mechanism.links[link].points[name]
+
+    def _need(self, order: int) -> None:
+        have = 0 if self.first is None else 1 if self.second is None else 2
+        if have < order:
+            raise ValueError(f"analogs of order {order} were not computed (analyze(..., order={order}))")
+
+    def quantity(self, name: str) -> tuple[np.ndarray, np.ndarray | None, np.ndarray | None]:
+        """Value and first / second analogs of ``"P.x"``, ``"P.y"``, ``"L.theta"`` or ``"K.s"``."""
+        kind, obj, axis = parse_quantity(self.mechanism, name)
+        if kind == "point":
+            link, local = self._point(obj)
+            value = global_point(self.poses[link], local)[:, axis]
+            if self.first is None:
+                return value, None, None
+            d1, d2 = point_analogs(self.poses[link], self.first[link],
+                                   self.second and self.second[link], local)
+            return value, d1[:, axis], None if d2 is None else d2[:, axis]
+        if kind == "link":
+            pick = (lambda d: None if d is None else d[obj][:, 2])
+            return self.poses[obj][:, 2], pick(self.first), pick(self.second)
+        joint = self.joints[obj]
+        return joint.slide(self.poses, self.first, self.second)
+
+    def velocity(self, name: str) -> np.ndarray:
+        """Real velocity of a quantity (``q' omega``), or of a point ``(N, 2)`` given its name."""
+        self._need_speed()
+        d1 = self.point_analogs(name)[0] if "." not in name else self.quantity(name)[1]
+        return d1 * (self.omega[:, None] if d1.ndim == 2 else self.omega)
+
+    def acceleration(self, name: str) -> np.ndarray:
+        """Real acceleration ``q'' omega^2 + q' eps`` of a quantity or of a point ``(N, 2)``."""
+        self._need_speed()
+        self._need(2)
+        if "." in name:
+            _, d1, d2 = self.quantity(name)
+            return d2 * self.omega**2 + d1 * self.eps
+        d1, d2 = self.point_analogs(name)
+        return d2 * self.omega[:, None] ** 2 + d1 * self.eps[:, None]
+
+    def _need_speed(self) -> None:
+        if self.omega is None:
+            raise ValueError("real velocities need omega (analyze(..., omega=..., eps=...))")
+
+    # -- table ---------------------------------------------------------------------------------
+    def columns(self) -> dict[str, np.ndarray]:
+        """The standard table: ``phi_deg``; per point ``P.x P.y P.x' P.y' P.x'' P.y''``; per moving
+        link ``L.theta L.theta' L.theta''``; per prismatic pair ``K.s K.s' K.s''`` (SI units)."""
+        mech = self.mechanism
+        cols: dict[str, np.ndarray] = {"phi_deg": np.degrees(self.phi)}
+        primes = ("", "'", "''")
+        for p in mech.point_names:
+            if mech.point_link(p) in self.poses:
+                values = {a: self.quantity(f"{p}.{a}") for a in "xy"}
+                for k, prime in enumerate(primes):
+                    for a in "xy":
+                        if values[a][k] is not None:
+                            cols[f"{p}.{a}{prime}"] = values[a][k]
+        quantities = [f"{link}.theta" for link in mech.moving_links if link in self.poses]
+        quantities += [f"{name}.s" for name, j in sorted(self.joints.items())
+                       if j.kind == "P" and j.a in self.poses and j.b in self.poses]
+        for q in quantities:
+            for prime, arr in zip(primes, self.quantity(q)):
+                if arr is not None:
+                    cols[q + prime] = arr
+        return cols
+
+
+def parse_quantity(mech: Mechanism, name: str) -> tuple[str, str, int]:
+    """``("point", P, 0|1)``, ``("link", L, 2)`` or ``("slide", K, 0)`` for a quantity name."""
+    obj, _, coord = name.rpartition(".")
+    if coord in ("x", "y") and any(obj in lk.points for lk in mech.links.values()):
+        return "point", obj, "xy".index(coord)
+    if coord == "theta" and obj in mech.links and obj != mech.frame:
+        return "link", obj, 2
+    if coord == "s" and isinstance(mech.pairs.get(obj), Prismatic):
+        return "slide", obj, 0
+    raise ValueError(
+        f"unknown quantity {name!r} of mechanism '{mech.name}': expected 'P.x' / 'P.y' for a point "
+        f"{mech.point_names}, 'L.theta' for a moving link {mech.moving_links}, or 'K.s' for a "
+        f"prismatic pair {sorted(k for k, p in mech.pairs.items() if isinstance(p, Prismatic))}"
+    )
+
+
+# ----------------------------------------------------------------------------------------------
+# the pipeline
+# ----------------------------------------------------------------------------------------------
+
+
+def analyze(
+    mech: Mechanism,
+    phi: ArrayLike,
+    *,
+    order: int = 2,
+    outputs: Iterable[str] | None = None,
+    omega: ArrayLike | None = None,
+    eps: ArrayLike | None = 0.0,
+    on_failure: Literal["raise", "mask"] = "raise",
+) -> Motion:
+    """Kinematics of ``mech`` at the input angles ``phi``.
+
+    Parameters
+    ----------
+    mech : Mechanism
+        The mechanism (one input link).
+    phi : array_like, shape (N,) or scalar
+        Input angles, rad (CCW from +x, METHOD section 1).
+    order : {0, 1, 2}
+        Highest analog order to compute (0: positions only).
+    outputs : iterable of str, optional
+        Only what these need is computed: point names, link names or quantities (``"B.x"``).
+        Default: everything.
+    omega, eps : array_like, optional
+        Input angular velocity (rad/s, signed) and acceleration (rad/s^2), scalars or ``(N,)``,
+        for real velocities and accelerations.
+    on_failure : {"raise", "mask"}
+        ``"raise"`` (default): :class:`AssemblyError` listing the input angles where a group
+        cannot be assembled or is singular. ``"mask"``: return them in ``Motion.status``.
+
+    Returns
+    -------
+    Motion
+    """
+    if order not in (0, 1, 2):
+        raise ValueError(f"order must be 0, 1 or 2, got {order!r}")
+    if on_failure not in ("raise", "mask"):
+        raise ValueError(f"on_failure must be 'raise' or 'mask', got {on_failure!r}")
+    structure = structure_of(mech)
+    if len(structure.inputs) != 1:
+        raise StructureError(
+            f"mechanism '{mech.name}' has {len(structure.inputs)} inputs; analysis over one input "
+            "angle needs exactly one input link")
+    phi = np.atleast_1d(np.asarray(phi, dtype=float))
+    if phi.ndim != 1 or not np.all(np.isfinite(phi)):
+        raise ValueError("phi must be a finite scalar or 1-D array of angles in rad")
+    branches = assembly_branches(mech)
+    group_ids = range(len(structure.groups)) if outputs is None else \
+        structure.needed_groups(_links_of(mech, outputs))
+    poses, first, second = _input_state(mech, structure, phi, order)
+    status = np.full(len(phi), OK)
+    for i in group_ids:
+        group = structure.groups[i]
+        placed = group.position(poses, branches[i])
+        poses.update(placed.poses)
+        status = np.where(status == OK, placed.status, status)
+        _check_continuity(group, placed, phi)
+        if order >= 1:
+            d1, d2 = group.analogs(poses, first, second)
+            first.update(d1)
+            if second is not None:
+                second.update(d2)
+    bad = status != OK
+    for d in (first, second):
+        if d is not None and bad.any():
+            for k in d:
+                d[k] = np.where(bad[:, None], np.nan, d[k])
+    if on_failure == "raise" and bad.any():
+        raise AssemblyError(_failure_message(mech, phi, status), np.degrees(phi[bad]))
+    omega_arr = eps_arr = None
+    if omega is not None:
+        omega_arr = np.broadcast_to(np.asarray(omega, dtype=float), phi.shape).copy()
+        eps_arr = np.broadcast_to(np.asarray(0.0 if eps is None else eps, dtype=float), phi.shape).copy()
+    joints = {name: joint_of(p, mech) for name, p in mech.pairs.items()}
+    return Motion(mech, structure, phi, poses, first if order >= 1 else None,
+                  second if order >= 2 else None, status, omega_arr, eps_arr, joints)
+
+
+def _links_of(mech: Mechanism, outputs: Iterable[str]) -> list[str]:
+    links = []
+    for name in outputs:
+        if name in mech.links:
+            links.append(name)
+        elif any(name in lk.points for lk in mech.links.values()):
+            links.append(mech.point_link(name))
+        else:
+            kind, obj, _ = parse_quantity(mech, name)
+            links += [mech.point_link(obj)] if kind == "point" else [obj] if kind == "link" \
+                else list(mech.pairs[obj].links)
+    return links
+
+
+def _input_state(mech: Mechanism, structure: Structure, phi: np.ndarray, order: int):
+    """Poses and analogs of the frame and the input link at the angles ``phi``."""
+    N = len(phi)
+    zeros = np.zeros((N, 3))
+    poses = {mech.frame: zeros.copy()}
+    first = {mech.frame: zeros.copy()} if order >= 1 else None
+    second = {mech.frame: zeros.copy()} if order >= 2 else None
+    for name in structure.inputs:
+        joint = structure.input_joints[name]
+        p_input, _, p_frame = joint.local(name)
+        pivot = np.asarray(p_frame, dtype=float)  # the frame's pose is the identity
+        rho = rotate(phi, p_input)
+        poses[name] = np.column_stack([pivot - rho, phi])
+        if first is not None:
+            first[name] = np.column_stack([-perp(rho), np.ones(N)])
+        if second is not None:
+            second[name] = np.column_stack([rho, np.zeros(N)])
+    return poses, first, second
+
+
+def _failure_message(mech: Mechanism, phi: np.ndarray, status: np.ndarray) -> str:
+    parts = []
+    for code, what in ((CANNOT_ASSEMBLE, "cannot be assembled"), (SINGULAR, "is singular")):
+        angles = np.degrees(phi[status == code])
+        if len(angles):
+            shown = ", ".join(f"{a:.6g}" for a in angles[:20]) + (" ..." if len(angles) > 20 else "")
+            parts.append(f"{what} at {len(angles)} input angle(s) (deg): {shown}")
+    return (f"mechanism '{mech.name}' " + "; ".join(parts)
+            + " (use on_failure='mask' to get a per-position status instead)")
+
+
+def _check_continuity(group, placed, phi) -> None:
+    """Warn when the sign of the group Jacobian's determinant differs between positions."""
+    signs = placed.jacobian_sign[placed.status == OK]
+    if len(signs) and np.any(signs != signs[0]):
+        changed = np.degrees(phi[(placed.status == OK) & (placed.jacobian_sign != signs[0])])
+        warnings.warn(
+            f"group {group!r} is in another assembly mode at input angles (deg) "
+            f"{np.array2string(changed[:10], precision=4)}: it passes a singular position between "
+            "analysed angles", BranchWarning, stacklevel=3)
+
+
+# ----------------------------------------------------------------------------------------------
+# assembly branches from readable conditions
+# ----------------------------------------------------------------------------------------------
+
+
+def assembly_branches(mech: Mechanism) -> tuple[int, ...]:
+    """The branch sign of every group, resolved from the mechanism's assembly conditions.
+
+    A condition such as "B lies left of the line A -> C" is evaluated on both closed-form
+    branches over a sweep of input angles; the branch that satisfies it at more positions wins.
+    """
+    cache = _cache(mech)
+    if "branches" in cache:
+        return cache["branches"]
+    structure = structure_of(mech)
+    rules = _rules_per_group(mech, structure)
+    phi = np.linspace(0.0, 2 * np.pi, BRANCH_SWEEP, endpoint=False)
+    poses, _, _ = _input_state(mech, structure, phi, 0)
+    branches = []
+    for i, group in enumerate(structure.groups):
+        rule = rules.get(i)
+        if rule is None:
+            chosen = 1
+        elif rule.rule == "branch":
+            chosen = rule.value
+        else:
+            votes = {}
+            for m in group.branches:
+                trial = {**poses, **group.position(poses, m).poses}
+                votes[m] = int(np.sum(_rule_score(mech, rule, trial) > 0))
+            if votes[1] == votes[-1]:
+                raise SchemeError(
+                    f"mechanism '{mech.name}': assembly of point '{rule.point}' ({rule.rule} "
+                    f"{list(rule.refs)}) does not tell the two branches of {group!r} apart "
+                    f"(each satisfies it at {votes[1]} of {BRANCH_SWEEP} input angles)")
+            chosen = max(votes, key=votes.get)
+        branches.append(chosen)
+        poses.update(group.position(poses, chosen).poses)
+    cache["branches"] = tuple(branches)
+    return cache["branches"]
+
+
+def _rules_per_group(mech: Mechanism, structure: Structure) -> dict:
+    rules: dict[int, object] = {}
+    problems = []
+    for rule in mech.assembly:
+        owners = [i for i, g in enumerate(structure.groups)
+                  if len(g.branches) > 1 and any(rule.point in mech.links[k].points for k in g.links)]
+        if not owners:
+            problems.append(f"assembly of point '{rule.point}': no group with two assembly branches "
+                            "places this point")
+        elif owners[0] in rules:
+            problems.append(f"assembly of point '{rule.point}': group {structure.groups[owners[0]]!r} "
+                            f"already has the condition on point '{rules[owners[0]].point}'")
+        else:
+            rules[owners[0]] = rule
+    for i, g in enumerate(structure.groups):
+        if len(g.branches) > 1 and i not in rules:
+            pts = sorted({p for k in g.links for p in mech.links[k].points})
+            problems.append(f"group {g!r} has two assembly branches: declare which one with an "
+                            f"assembly condition on one of its points {pts}")
+    if problems:
+        raise SchemeError([f"mechanism '{mech.name}': {p}" for p in problems])
+    return rules
+
+
+def _rule_score(mech: Mechanism, rule, poses) -> np.ndarray:
+    """Positive where the condition holds (NaN where a point is not placed)."""
+
+    def at(point):
+        for link in mech.point_links(point):
+            if link in poses:
+                return global_point(poses[link], mech.links[link].points[point])
+        raise SchemeError(f"assembly of point '{rule.point}': point '{point}' is not placed yet")
+
+    P = at(rule.point)
+    if rule.rule in ("left_of", "right_of"):
+        X, Y = at(rule.refs[0]), at(rule.refs[1])
+        side = (Y - X)[:, 0] * (P - X)[:, 1] - (Y - X)[:, 1] * (P - X)[:, 0]
+        return side if rule.rule == "left_of" else -side
+    X = at(rule.refs[0])
+    return (P - X) @ np.array([np.cos(rule.angle), np.sin(rule.angle)])

@@ -1,0 +1,576 @@
+"""The mechanism model: links, kinematic pairs and the graph they form.
+
+A :class:`Mechanism` is a graph whose nodes are links (the frame among them) and whose edges are
+kinematic pairs. Geometry lives in each link's own frame (METHOD section 3): a link's pose is the
+global position of its local origin and the angle of its local x axis.
+
+Build one with :class:`MechanismBuilder` (the scheme loader uses the same builder), e.g.
+
+>>> from linkage.model import MechanismBuilder
+>>> b = MechanismBuilder("four_bar")
+>>> _ = b.link("0", points={"O": (0.0, 0.0), "C": (0.3, 0.0)})
+>>> _ = b.link("1", line=("O", "A"), length=0.1)
+>>> _ = b.link("2", line=("A", "B"), length=0.3)
+>>> _ = b.link("3", line=("C", "B"), length=0.25)
+>>> for name, a, c in [("O", "0", "1"), ("A", "1", "2"), ("B", "2", "3"), ("C", "3", "0")]:
+...     _ = b.revolute(name, a, c)
+>>> _ = b.inputs("1").assembly("B", left_of=("A", "C"))
+>>> b.build().name
+'four_bar'
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from functools import cached_property
+from typing import Any, Mapping
+
+import networkx as nx
+
+from .errors import SchemeError
+
+__all__ = [
+    "Guide",
+    "Link",
+    "Revolute",
+    "Prismatic",
+    "Assembly",
+    "Output",
+    "Mechanism",
+    "MechanismBuilder",
+]
+
+Vec = tuple[float, float]
+
+
+@dataclass(frozen=True)
+class Guide:
+    """A straight guide line fixed in a link.
+
+    Parameters
+    ----------
+    point : (float, float)
+        A point of the line in the link's frame, m (any declared offset already applied).
+    angle : float
+        Direction of the line in the link's frame, rad (CCW from the link's x axis).
+    """
+
+    point: Vec
+    angle: float
+
+    @property
+    def direction(self) -> Vec:
+        return (math.cos(self.angle), math.sin(self.angle))
+
+
+@dataclass(frozen=True)
+class Link:
+    """A rigid link.
+
+    Parameters
+    ----------
+    name : str
+        Unique name.
+    points : mapping of str to (float, float)
+        Named points in the link's own frame, m.
+    guides : mapping of str to Guide
+        Guide lines fixed in the link (for prismatic pairs where this link is the guide).
+    mass : float
+        kg (0 when not declared, see ``mass_declared``).
+    center_of_mass : (float, float)
+        Local coordinates of the centre of mass S, m.
+    inertia : float
+        Moment of inertia about S, kg m^2.
+    mass_declared : bool
+        False when the declaration gave no mass (treated as zero, with a note in reports).
+    """
+
+    name: str
+    points: Mapping[str, Vec] = field(default_factory=dict)
+    guides: Mapping[str, Guide] = field(default_factory=dict)
+    mass: float = 0.0
+    center_of_mass: Vec = (0.0, 0.0)
+    inertia: float = 0.0
+    mass_declared: bool = False
+
+
+@dataclass(frozen=True)
+class Revolute:
+    """A revolute (turning) pair joining ``links[0]`` and ``links[1]`` at the point ``point``.
+
+    The point of that name must be declared on both links.
+    """
+
+    name: str
+    links: tuple[str, str]
+    point: str
+    kind = "R"
+
+
+@dataclass(frozen=True)
+class Prismatic:
+    """A prismatic (sliding) pair: ``links[1]`` (the slider) slides along a guide of ``links[0]``.
+
+    Parameters
+    ----------
+    name : str
+        Unique pair name.
+    links : (str, str)
+        (guide link, slider link).
+    guide : str
+        Name of the guide line on the guide link.
+    point : str
+        The slider's point that stays on the guide line.
+    angle : float
+        Fixed angle of the slider's x axis relative to the guide direction, rad (beta in METHOD).
+    """
+
+    name: str
+    links: tuple[str, str]
+    guide: str
+    point: str
+    angle: float = 0.0
+    kind = "P"
+
+
+@dataclass(frozen=True)
+class Assembly:
+    """A readable assembly condition that picks a group's branch.
+
+    ``rule`` is one of
+
+    - ``"left_of"`` / ``"right_of"``: ``point`` lies left / right of the directed line
+      ``refs[0] -> refs[1]``;
+    - ``"towards"``: ``point`` lies from ``refs[0]`` in the direction ``angle`` (rad), i.e.
+      ``(P - X) . (cos angle, sin angle) > 0``;
+    - ``"branch"``: the raw branch sign ``M = value`` of the group's solver (documented per kind).
+    """
+
+    point: str
+    rule: str
+    refs: tuple[str, ...] = ()
+    angle: float = 0.0
+    value: int = 1
+
+
+@dataclass(frozen=True)
+class Output:
+    """The output coordinate that defines extreme positions and the start of tables.
+
+    ``quantity`` is ``"P.x"``, ``"P.y"`` (point), ``"L.theta"`` (link angle) or ``"K.s"``
+    (slide of prismatic pair K); ``start`` is ``"max"`` or ``"min"``: which extreme position
+    starts the cycle.
+    """
+
+    quantity: str
+    start: str = "max"
+
+
+@dataclass(frozen=True, eq=True)
+class Mechanism:
+    """A planar mechanism with lower pairs.
+
+    Use :class:`MechanismBuilder` or :func:`linkage.load` to make one: they validate it.
+    """
+
+    name: str
+    links: Mapping[str, Link]
+    pairs: Mapping[str, Revolute | Prismatic]
+    inputs: tuple[str, ...]
+    frame: str = "0"
+    assembly: tuple[Assembly, ...] = ()
+    output: Output | None = None
+    description: str = ""
+    extra: Mapping[str, Any] = field(default_factory=dict, compare=True)
+
+    @cached_property
+    def graph(self) -> nx.MultiGraph:
+        """Links as nodes (attribute ``link``), pairs as edges (key = pair name, ``pair``)."""
+        g = nx.MultiGraph(name=self.name)
+        for name in sorted(self.links):
+            g.add_node(name, link=self.links[name])
+        for name in sorted(self.pairs):
+            pair = self.pairs[name]
+            g.add_edge(*pair.links, key=name, pair=pair)
+        return g
+
+    @cached_property
+    def size(self) -> float:
+        """Characteristic length, m: the largest distance between two points of one link."""
+        size = 0.0
+        for link in self.links.values():
+            pts = list(link.points.values()) + [g.point for g in link.guides.values()]
+            for i, p in enumerate(pts):
+                for q in pts[i + 1 :]:
+                    size = max(size, math.dist(p, q))
+        return size if size > 0 else 1.0
+
+    def point_link(self, point: str) -> str:
+        """Name of the link that reports the position of ``point`` (frame first, then by name)."""
+        owners = self.point_links(point)
+        if not owners:
+            raise SchemeError(f"mechanism '{self.name}': unknown point '{point}'")
+        return owners[0]
+
+    def point_links(self, point: str) -> list[str]:
+        """All links declaring ``point``, frame first, then sorted by name."""
+        owners = sorted(n for n, lk in self.links.items() if point in lk.points)
+        if self.frame in owners:
+            owners.remove(self.frame)
+            owners.insert(0, self.frame)
+        return owners
+
+    @cached_property
+    def point_names(self) -> list[str]:
+        """Every named point, sorted."""
+        return sorted({p for lk in self.links.values() for p in lk.points})
+
+    @property
+    def moving_links(self) -> list[str]:
+        return sorted(n for n in self.links if n != self.frame)
+
+    def with_extra(self, **extra: Any) -> "Mechanism":
+        """A copy with more entries in ``extra`` (loads, dynamics inputs declared by schemes)."""
+        merged = dict(self.extra)
+        merged.update(extra)
+        return Mechanism(
+            self.name, self.links, self.pairs, self.inputs, self.frame, self.assembly,
+            self.output, self.description, merged,
+        )
+
+
+# ----------------------------------------------------------------------------------------------
+# Builder: the one way to declare a mechanism (the scheme loader calls it too)
+# ----------------------------------------------------------------------------------------------
+
+
+def _angle(spec: Mapping[str, Any], key: str, where: str, problems: list[str], default=0.0):
+    """Read ``key`` (rad) or ``key_deg`` (deg) from ``spec``; return radians."""
+    has_rad, has_deg = key in spec, f"{key}_deg" in spec
+    if has_rad and has_deg:
+        problems.append(f"{where}: give either '{key}' or '{key}_deg', not both")
+        return default
+    raw = spec.get(key, spec.get(f"{key}_deg", None))
+    if raw is None:
+        return default
+    if not _is_number(raw):
+        problems.append(f"{where}: '{key}{'_deg' if has_deg else ''}' must be a number, got {raw!r}")
+        return default
+    return math.radians(raw) if has_deg else float(raw)
+
+
+def _is_number(x: Any) -> bool:
+    return isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
+
+
+def _vector(raw: Any) -> Vec | None:
+    if isinstance(raw, (list, tuple)) and len(raw) == 2 and all(_is_number(v) for v in raw):
+        return (float(raw[0]), float(raw[1]))
+    return None
+
+
+class MechanismBuilder:
+    """Declare a mechanism step by step, then :meth:`build` it (validated, all problems at once).
+
+    Every method returns the builder so calls can be chained. Lengths in m, angles in rad
+    (or ``*_deg`` keys in point / guide specifications), masses in kg.
+    """
+
+    def __init__(self, name: str, description: str = "", frame: str = "0"):
+        self.name = name
+        self.description = description
+        self.frame = frame
+        self._links: dict[str, Link] = {}
+        self._pairs: dict[str, Revolute | Prismatic] = {}
+        self._inputs: list[str] = []
+        self._assembly: list[Assembly] = []
+        self._output: Output | None = None
+        self._problems: list[str] = []
+
+    # -- links ---------------------------------------------------------------------------------
+    def link(
+        self,
+        name: str,
+        *,
+        line: tuple[str, str] | None = None,
+        length: float | None = None,
+        points: Mapping[str, Any] | None = None,
+        guides: Mapping[str, Any] | None = None,
+        mass: float | None = None,
+        com: str | Vec | None = None,
+        inertia: float | None = None,
+    ) -> "MechanismBuilder":
+        """Declare a link.
+
+        Parameters
+        ----------
+        name : str
+            Link name (the frame is ``self.frame``, "0" by default).
+        line, length : (str, str), float
+            A binary link by its length: ``line[0]`` at the local origin, ``line[1]`` at
+            ``(length, 0)``; the local x axis runs along the line.
+        points : mapping
+            More points: ``(x, y)`` in the link's frame, or ``{"from": P, "distance": d,
+            "angle_deg": a}`` -- at distance d from point P, at angle a CCW from the link's x axis.
+        guides : mapping
+            Guide lines: ``{"through": P or (x, y), "angle_deg": a, "offset": e}``: through the
+            point, at angle a from the link's x axis, shifted by e along the line's left normal.
+        mass, com, inertia : float, str or (x, y), float
+            Mass (kg), centre of mass (a point name or local coordinates), J_S (kg m^2).
+        """
+        where = f"link '{name}'"
+        p = self._problems
+        if name in self._links:
+            p.append(f"{where}: declared twice")
+            return self
+        local: dict[str, Vec] = {}
+        if line is not None or length is not None:
+            if line is None or len(line) != 2 or not all(isinstance(s, str) for s in line):
+                p.append(f"{where}: 'line' must name two points, got {line!r}")
+            elif line[0] == line[1]:
+                p.append(f"{where}: 'line' joins point '{line[0]}' to itself")
+            elif length is None or not _is_number(length) or length <= 0:
+                p.append(f"{where}: length must be a positive number, got {length!r}")
+            else:
+                local[line[0]] = (0.0, 0.0)
+                local[line[1]] = (float(length), 0.0)
+        for pname, spec in (points or {}).items():
+            pwhere = f"{where} point '{pname}'"
+            if pname in local:
+                p.append(f"{pwhere}: declared twice")
+                continue
+            vec = _vector(spec)
+            if vec is None and isinstance(spec, Mapping):
+                vec = self._relative_point(spec, local, pwhere)
+            elif vec is None:
+                p.append(f"{pwhere}: expected [x, y] or {{from, distance, angle_deg}}, got {spec!r}")
+            if vec is not None:
+                local[pname] = vec
+        link_guides: dict[str, Guide] = {}
+        for gname, spec in (guides or {}).items():
+            gwhere = f"{where} guide '{gname}'"
+            if not isinstance(spec, Mapping):
+                p.append(f"{gwhere}: expected {{through, angle_deg, offset}}, got {spec!r}")
+                continue
+            unknown = set(spec) - {"through", "angle", "angle_deg", "offset"}
+            if unknown:
+                p.append(f"{gwhere}: unknown keys {sorted(unknown)}")
+            through = spec.get("through", (0.0, 0.0))
+            base = local.get(through) if isinstance(through, str) else _vector(through)
+            if base is None:
+                p.append(f"{gwhere}: 'through' must be a point of the link or [x, y], got {through!r}")
+                continue
+            angle = _angle(spec, "angle", gwhere, p)
+            offset = spec.get("offset", 0.0)
+            if not _is_number(offset):
+                p.append(f"{gwhere}: offset must be a number, got {offset!r}")
+                offset = 0.0
+            nx_, ny_ = -math.sin(angle), math.cos(angle)
+            link_guides[gname] = Guide((base[0] + offset * nx_, base[1] + offset * ny_), angle)
+        for label, value in (("mass", mass), ("inertia", inertia)):
+            if value is not None and (not _is_number(value) or value < 0):
+                p.append(f"{where}: {label} must be a number >= 0, got {value!r}")
+        center: Vec = (0.0, 0.0)
+        if com is not None:
+            center_or_none = local.get(com) if isinstance(com, str) else _vector(com)
+            if center_or_none is None:
+                p.append(f"{where}: centre of mass must be a point of the link or [x, y], got {com!r}")
+            else:
+                center = center_or_none
+        elif mass and _is_number(mass) and mass > 0:
+            p.append(f"{where}: mass {mass} kg is given without a centre of mass ('com')")
+        ok_mass = mass is not None and _is_number(mass) and mass >= 0
+        ok_inertia = inertia is not None and _is_number(inertia) and inertia >= 0
+        self._links[name] = Link(
+            name,
+            local,
+            link_guides,
+            float(mass) if ok_mass else 0.0,
+            center,
+            float(inertia) if ok_inertia else 0.0,
+            mass is not None,
+        )
+        return self
+
+    def _relative_point(self, spec: Mapping[str, Any], local: dict[str, Vec], where: str) -> Vec | None:
+        p = self._problems
+        unknown = set(spec) - {"from", "distance", "angle", "angle_deg"}
+        if unknown:
+            p.append(f"{where}: unknown keys {sorted(unknown)}")
+        origin = spec.get("from")
+        if origin not in local:
+            p.append(f"{where}: 'from' must name an earlier point of the link, got {origin!r}")
+            return None
+        distance = spec.get("distance")
+        if not _is_number(distance) or distance < 0:
+            p.append(f"{where}: distance must be a number >= 0, got {distance!r}")
+            return None
+        angle = _angle(spec, "angle", where, p)
+        ox, oy = local[origin]
+        return (ox + distance * math.cos(angle), oy + distance * math.sin(angle))
+
+    # -- pairs ---------------------------------------------------------------------------------
+    def revolute(self, name: str, link_a: str, link_b: str, at: str | None = None) -> "MechanismBuilder":
+        """Pin ``link_a`` and ``link_b`` at the point ``at`` (default: the pair's name)."""
+        if self._check_pair_name(name):
+            self._pairs[name] = Revolute(name, (link_a, link_b), at if at is not None else name)
+        return self
+
+    def prismatic(
+        self, name: str, guide_link: str, slider_link: str, *, guide: str, at: str, angle: float = 0.0
+    ) -> "MechanismBuilder":
+        """Let ``slider_link``'s point ``at`` slide on guide ``guide`` of ``guide_link``.
+
+        ``angle`` is the fixed angle of the slider's x axis to the guide direction (rad).
+        """
+        if self._check_pair_name(name):
+            self._pairs[name] = Prismatic(name, (guide_link, slider_link), guide, at, float(angle))
+        return self
+
+    def _check_pair_name(self, name: str) -> bool:
+        if name in self._pairs:
+            self._problems.append(f"pair '{name}': declared twice")
+            return False
+        return True
+
+    # -- the rest ------------------------------------------------------------------------------
+    def inputs(self, *links: str) -> "MechanismBuilder":
+        """Declare the input links (cranks), each pinned to the frame; its angle is ``phi``."""
+        self._inputs.extend(links)
+        return self
+
+    def assembly(
+        self,
+        point: str,
+        *,
+        left_of: tuple[str, str] | None = None,
+        right_of: tuple[str, str] | None = None,
+        towards: float | None = None,
+        origin: str | None = None,
+        branch: int | None = None,
+    ) -> "MechanismBuilder":
+        """Pick the assembly branch of the group that places ``point``.
+
+        Exactly one of: ``left_of=(X, Y)`` / ``right_of=(X, Y)`` (the point lies left / right of
+        the directed line X -> Y); ``towards=angle`` with ``origin=X`` (the point lies from X in
+        that direction, rad); ``branch=+1/-1`` (the solver's raw sign, see its kind).
+        """
+        where = f"assembly of point '{point}'"
+        given = [k for k, v in (("left_of", left_of), ("right_of", right_of), ("towards", towards),
+                                ("branch", branch)) if v is not None]
+        if len(given) != 1:
+            self._problems.append(
+                f"{where}: give exactly one of left_of, right_of, towards(_deg), branch; got {given}")
+            return self
+        if left_of is not None or right_of is not None:
+            refs = left_of if left_of is not None else right_of
+            if not (isinstance(refs, (list, tuple)) and len(refs) == 2):
+                self._problems.append(f"{where}: {given[0]} must name two points, got {refs!r}")
+                return self
+            self._assembly.append(Assembly(point, given[0], tuple(refs)))
+        elif towards is not None:
+            if origin is None or not _is_number(towards):
+                self._problems.append(f"{where}: 'towards' needs an angle and 'from' a point")
+                return self
+            self._assembly.append(Assembly(point, "towards", (origin,), float(towards)))
+        else:
+            if branch not in (1, -1):
+                self._problems.append(f"{where}: branch must be +1 or -1, got {branch!r}")
+                return self
+            self._assembly.append(Assembly(point, "branch", value=int(branch)))
+        return self
+
+    def output(self, quantity: str, start: str = "max") -> "MechanismBuilder":
+        """Declare the output coordinate (``"B.x"``, ``"3.theta"``, ``"K.s"``) and its start."""
+        self._output = Output(quantity, start)
+        return self
+
+    def build(self, **extra: Any) -> Mechanism:
+        """Validate and return the mechanism; raise :class:`SchemeError` listing every problem."""
+        if self.frame not in self._links:
+            self._links[self.frame] = Link(self.frame)
+        mech = Mechanism(
+            self.name,
+            dict(self._links),
+            dict(self._pairs),
+            tuple(self._inputs),
+            self.frame,
+            tuple(self._assembly),
+            self._output,
+            self.description,
+            dict(extra),
+        )
+        problems = self._problems + validate(mech)
+        if problems:
+            raise SchemeError(problems)
+        return mech
+
+
+def validate(mech: Mechanism) -> list[str]:
+    """Every problem of a mechanism's declaration (empty when it is sound)."""
+    p: list[str] = []
+    links = mech.links
+    for pair in mech.pairs.values():
+        where = f"pair '{pair.name}'"
+        a, b = pair.links
+        bad = [x for x in (a, b) if x not in links]
+        for x in bad:
+            p.append(f"{where}: joins unknown link '{x}'")
+        if bad:
+            continue
+        if a == b:
+            p.append(f"{where}: joins link '{a}' to itself")
+            continue
+        if isinstance(pair, Revolute):
+            for x in (a, b):
+                if pair.point not in links[x].points:
+                    p.append(f"{where}: point '{pair.point}' is not declared on link '{x}'")
+        else:
+            if pair.guide not in links[a].guides:
+                p.append(f"{where}: link '{a}' has no guide '{pair.guide}' "
+                         f"(it has {sorted(links[a].guides) or 'none'})")
+            if pair.point not in links[b].points:
+                p.append(f"{where}: point '{pair.point}' is not declared on slider link '{b}'")
+    clash = sorted(set(mech.pairs) & set(links))
+    for name in clash:
+        p.append(f"name '{name}' is used for both a link and a pair")
+    if not mech.inputs:
+        p.append("no input link declared (input = \"<link>\")")
+    if len(set(mech.inputs)) != len(mech.inputs):
+        p.append(f"input links declared twice: {list(mech.inputs)}")
+    for name in mech.inputs:
+        if name not in links:
+            p.append(f"input link '{name}' is not a declared link")
+        elif name == mech.frame:
+            p.append(f"input link '{name}' is the frame")
+        elif not any(isinstance(pr, Revolute) and set(pr.links) == {name, mech.frame}
+                     for pr in mech.pairs.values()):
+            p.append(f"input link '{name}' is not pinned to the frame '{mech.frame}' by a revolute pair")
+    known_points = {q for lk in links.values() for q in lk.points}
+    for rule in mech.assembly:
+        for q in (rule.point, *rule.refs):
+            if q not in known_points:
+                p.append(f"assembly of point '{rule.point}': unknown point '{q}'")
+    if mech.output is not None:
+        p.extend(_output_problems(mech))
+    return p
+
+
+def _output_problems(mech: Mechanism) -> list[str]:
+    out = mech.output
+    where = f"output '{out.quantity}'"
+    problems = []
+    if out.start not in ("max", "min"):
+        problems.append(f"{where}: start must be 'max' or 'min', got {out.start!r}")
+    name, _, coord = out.quantity.rpartition(".")
+    points = {q for lk in mech.links.values() for q in lk.points}
+    ok = (
+        (coord in ("x", "y") and name in points)
+        or (coord == "theta" and name in mech.links and name != mech.frame)
+        or (coord == "s" and isinstance(mech.pairs.get(name), Prismatic))
+    )
+    if not ok:
+        problems.append(f"{where}: expected 'P.x', 'P.y' (point), 'L.theta' (moving link) or "
+                        f"'K.s' (prismatic pair)")
+    return problems

@@ -1,0 +1,180 @@
+"""Structural analysis: mobility (Chebyshev) and decomposition into Assur groups (METHOD 2).
+
+Plain functions on a :class:`~linkage.model.Mechanism`:
+
+>>> import linkage
+>>> mech = linkage.load("slider_crank")
+>>> mobility(mech)
+1
+>>> decompose(mech).formula
+'I(0,1) → II-RRP(2,3)'
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from itertools import combinations
+
+from assur import Group, PrismaticJoint, RevoluteJoint, solver_for
+
+from .errors import StructureError
+from .model import Mechanism, Prismatic, Revolute
+
+__all__ = ["Structure", "mobility", "decompose", "joint_of"]
+
+#: largest group size searched (class III groups have 4 links)
+MAX_GROUP_LINKS = 4
+
+
+@dataclass(frozen=True)
+class Structure:
+    """The decomposition of a mechanism.
+
+    Attributes
+    ----------
+    inputs : tuple of str
+        Input links, each forming a class-I mechanism with the frame.
+    input_joints : dict
+        Input link -> the revolute joint pinning it to the frame.
+    groups : tuple of Group
+        Bound group solvers in the order of kinematic analysis.
+    """
+
+    frame: str
+    inputs: tuple[str, ...]
+    input_joints: dict[str, RevoluteJoint]
+    groups: tuple[Group, ...]
+
+    @property
+    def formula(self) -> str:
+        """Structural formula, e.g. ``I(0,1) → II-RPR(2,3) → II-PRP(4,5)``."""
+        parts = [f"I({self.frame},{name})" for name in self.inputs]
+        parts += [repr(g) for g in self.groups]
+        return " → ".join(parts)
+
+    def group_of(self, link: str) -> int | None:
+        """Index of the group that places ``link`` (None for the frame and input links)."""
+        for i, g in enumerate(self.groups):
+            if link in g.links:
+                return i
+        return None
+
+    def needed_groups(self, links) -> list[int]:
+        """Indices (in order) of the groups needed to place ``links``: theirs and their ancestors."""
+        needed: set[int] = set()
+        stack = [i for i in (self.group_of(k) for k in links) if i is not None]
+        while stack:
+            i = stack.pop()
+            if i in needed:
+                continue
+            needed.add(i)
+            stack += [j for j in (self.group_of(k) for k in self.groups[i].known_links) if j is not None]
+        return sorted(needed)
+
+
+def mobility(mech: Mechanism) -> int:
+    """Degrees of freedom by Chebyshev's formula ``W = 3 n - 2 p5 - p4`` (lower pairs only)."""
+    return 3 * len(mech.moving_links) - 2 * len(mech.pairs)
+
+
+def joint_of(pair: Revolute | Prismatic, mech: Mechanism) -> RevoluteJoint | PrismaticJoint:
+    """The solver-side joint (local geometry resolved) of a model pair."""
+    a, b = pair.links
+    la, lb = mech.links[a], mech.links[b]
+    if isinstance(pair, Revolute):
+        return RevoluteJoint(pair.name, a, b, la.points[pair.point], lb.points[pair.point])
+    guide = la.guides[pair.guide]
+    return PrismaticJoint(pair.name, a, b, guide.point, guide.direction, lb.points[pair.point], pair.angle)
+
+
+def decompose(mech: Mechanism) -> Structure:
+    """Decompose a mechanism into its input links and an ordered sequence of Assur groups.
+
+    At each step the smallest set of unknown links forming a group on the known links is taken
+    (ties broken by sorted link names, so the result does not depend on declaration order).
+
+    Raises
+    ------
+    StructureError
+        When the mobility differs from the number of inputs, or links are left over; the
+        message names the links and pairs involved.
+    """
+    w = mobility(mech)
+    if w != len(mech.inputs):
+        raise StructureError(
+            f"mechanism '{mech.name}': mobility W = 3·{len(mech.moving_links)} - 2·{len(mech.pairs)}"
+            f" = {w}, but {len(mech.inputs)} input link(s) are declared {list(mech.inputs)}"
+        )
+    joints = {name: joint_of(pair, mech) for name, pair in mech.pairs.items()}
+    input_joints = {}
+    for name in mech.inputs:
+        pivot = sorted(j for j, p in mech.pairs.items()
+                       if isinstance(p, Revolute) and set(p.links) == {name, mech.frame})
+        input_joints[name] = joints[pivot[0]]
+    used = {j.name for j in input_joints.values()}
+    known = {mech.frame, *mech.inputs}
+    unknown = sorted(set(mech.links) - known)
+    groups: list[Group] = []
+    while unknown:
+        group = _next_group(unknown, known, joints, used, mech.size)
+        if group is None:
+            left_pairs = sorted(set(joints) - used)
+            raise StructureError(
+                f"mechanism '{mech.name}': links {unknown} cannot be decomposed into Assur groups "
+                f"on the known links {sorted(known)} (remaining pairs: {left_pairs}); "
+                + _why_not(unknown, known, joints, used)
+            )
+        groups.append(group)
+        known |= set(group.links)
+        used |= {j.name for j in group.joints}
+        unknown = [k for k in unknown if k not in known]
+    return Structure(mech.frame, tuple(mech.inputs), input_joints, tuple(groups))
+
+
+def _group_joints(subset, known, joints, used):
+    inside = set(subset) | known
+    return [j for name, j in sorted(joints.items())
+            if name not in used and (j.a in subset or j.b in subset) and j.a in inside and j.b in inside]
+
+
+def _is_group(subset, known, joints, used) -> bool:
+    """3 n = 2 p and no proper subset over-constrained (so none is floating)."""
+    gj = _group_joints(subset, known, joints, used)
+    if 3 * len(subset) != 2 * len(gj):
+        return False
+    for r in range(1, len(subset)):
+        for part in combinations(subset, r):
+            if 2 * len(_group_joints(part, known, joints, used)) >= 3 * len(part):
+                return False
+    return True
+
+
+def _next_group(unknown, known, joints, used, size) -> Group | None:
+    for n in range(2, MAX_GROUP_LINKS + 1, 2):
+        for subset in combinations(unknown, n):
+            if not _is_group(subset, known, joints, used):
+                continue
+            solver = solver_for(subset, _group_joints(subset, known, joints, used), known, size)
+            if solver is None:
+                raise StructureError(
+                    f"links {list(subset)} form a group with pairs "
+                    f"{[_describe(j) for j in _group_joints(subset, known, joints, used)]} "
+                    "but no registered solver handles it (kinds: RRR, RRP, RPR, PRP, RPP with the "
+                    "guide of each external prismatic pair on the known link)"
+                )
+            return solver
+    return None
+
+
+def _describe(j) -> str:
+    if isinstance(j, PrismaticJoint):
+        return f"{j.name}: P guide {j.a} / slider {j.b}"
+    return f"{j.name}: R {j.a}-{j.b}"
+
+
+def _why_not(unknown, known, joints, used) -> str:
+    free = [k for k in unknown if not any(k in (j.a, j.b) for n, j in joints.items() if n not in used)]
+    if free:
+        return f"links {free} have no pairs"
+    return "they form no statically determinate group (check the pairs of these links)"
+
