@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import brentq
 
-from .kinematics import analyze
+from .kinematics import _cache, analyze
 from .model import Mechanism
 
 __all__ = ["Extremes", "extreme_positions", "table_angles"]
@@ -78,7 +78,14 @@ def extreme_positions(mech: Mechanism, quantity: str | None = None, *, samples: 
         When the quantity has no extreme position over a revolution (it is monotonic or constant).
     """
     quantity = _output_quantity(mech, quantity)
+    key = ("extremes", quantity, samples, xtol)
+    cache = _cache(mech)
+    if key not in cache:
+        cache[key] = _find_extremes(mech, quantity, samples, xtol)
+    return cache[key]
 
+
+def _find_extremes(mech: Mechanism, quantity: str, samples: int, xtol: float) -> Extremes:
     def derivative(phi: float) -> float:
         return analyze(mech, [phi], order=1, outputs=[quantity]).quantity(quantity)[1][0]
 

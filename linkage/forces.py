@@ -1,0 +1,407 @@
+"""Loads on a mechanism: gravity, inertia, external forces and moments, force diagrams.
+
+METHOD sections 5 and 7. A :class:`Loads` collects what acts on the links; given a
+:class:`~linkage.kinematics.Motion` with real speeds it is evaluated into per-position
+:class:`LoadTerm` s (a force at a point of a link and a moment on the link), which the
+kinetostatics and the dynamics consume.
+
+Declared in scheme files as::
+
+    [loads]
+    gravity = [0.0, -9.81]            # m/s^2 (the default); [0, 0] for a machine lying flat
+
+    [[loads.forces]]                  # a constant force at point E of link 2
+    point = "E"
+    link = "2"                        # needed only when E is on several moving links
+    force = [0.0, -100.0]             # N
+
+    [[loads.forces]]                  # a force diagram over the working stroke of B.x
+    point = "B"
+    link = "3"
+    diagram = { along = "x", working = "+", fractions = [0, 0.5, 1], values = [0, 800, 0] }
+
+    [[loads.moments]]                 # a moment on link 3, N m, CCW positive
+    link = "3"
+    moment = -5.0
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Mapping, Sequence
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from .extremes import extreme_positions
+from .kinematics import Motion
+from .model import Mechanism, _is_number
+from .scheme import SECTION_VALIDATORS
+
+__all__ = [
+    "StrokeDiagram",
+    "PointForce",
+    "LinkMoment",
+    "Loads",
+    "LoadTerm",
+    "loads_of",
+    "evaluate_loads",
+    "inertia_terms",
+    "generalized_loads",
+    "STANDARD_GRAVITY",
+]
+
+STANDARD_GRAVITY = (0.0, -9.81)
+
+
+@dataclass(frozen=True)
+class StrokeDiagram:
+    """A force (or moment) diagram over the working stroke of an output coordinate (METHOD 7).
+
+    Parameters
+    ----------
+    quantity : str
+        The output coordinate (``"B.x"``, ``"B.y"`` or ``"3.theta"``); the load acts along it.
+    working : {1, -1}
+        The working stroke is the half-cycle in which the quantity increases (+1) or decreases.
+    fractions, values : sequence of float
+        Diagram points: fraction of the working stroke, 0 (start) .. 1 (end), increasing; and the
+        load's magnitude there (N or N m, >= 0). Linear in between; zero on the idle stroke unless
+        ``idle_fractions`` / ``idle_values`` are given.
+    opposes : bool
+        True (default): the load opposes the working motion (a useful resistance); False: it
+        drives it.
+    """
+
+    quantity: str
+    working: int
+    fractions: tuple[float, ...]
+    values: tuple[float, ...]
+    opposes: bool = True
+    idle_fractions: tuple[float, ...] = ()
+    idle_values: tuple[float, ...] = ()
+
+    def magnitude(self, mech: Mechanism, value, first, second, rotation: float, ends=None):
+        """Signed load along the quantity at positions with the given value and analogs.
+
+        At a stroke end the load is two-valued: a position counts in the stroke the mechanism
+        enters (sign of ``q''`` times the rotation), or in the one it leaves where ``ends`` is True.
+        """
+        ext = extreme_positions(mech, self.quantity)
+        stroke = ext.value_max - ext.value_min
+        moving = np.sign(first)
+        at_end = np.abs(first) <= 1e-9 * stroke
+        leaving = np.zeros(len(value), bool) if ends is None else np.asarray(ends, bool)
+        entering_dir = np.sign(second * rotation) * np.where(leaving, -1.0, 1.0)
+        direction = np.where(at_end, entering_dir, moving)
+        working = direction == self.working
+        start = ext.value_min if self.working > 0 else ext.value_max
+        t = np.clip(np.abs(value - start) / stroke, 0.0, 1.0)
+        work_mag = np.interp(t, self.fractions, self.values)
+        if self.idle_fractions:
+            idle_mag = np.interp(1.0 - t, self.idle_fractions, self.idle_values)
+        else:
+            idle_mag = np.zeros_like(t)
+        mag = np.where(working, work_mag, idle_mag)
+        sign = -self.working if self.opposes else self.working
+        # on the idle stroke the motion is reversed: an opposing load still opposes the motion
+        return np.where(working, sign * mag, -sign * mag)
+
+
+@dataclass(frozen=True)
+class PointForce:
+    """A force at a named point of a link: a constant vector, per-position vectors, or a diagram."""
+
+    point: str
+    link: str
+    force: Any  # (2,), (N, 2) or StrokeDiagram
+
+
+@dataclass(frozen=True)
+class LinkMoment:
+    """A moment on a link (N m, CCW positive): a constant, per-position values, or a diagram."""
+
+    link: str
+    moment: Any  # float, (N,) or StrokeDiagram
+
+
+@dataclass(frozen=True)
+class Loads:
+    """Everything applied to a mechanism besides inertia.
+
+    Attributes
+    ----------
+    gravity : (float, float)
+        Acceleration of gravity, m/s^2 (zero allowed).
+    forces, moments : tuple
+        :class:`PointForce` and :class:`LinkMoment` entries.
+    notes : tuple of str
+        Remarks for reports (e.g. links without a declared mass, treated as massless).
+    """
+
+    gravity: tuple[float, float] = STANDARD_GRAVITY
+    forces: tuple[PointForce, ...] = ()
+    moments: tuple[LinkMoment, ...] = ()
+    notes: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
+class LoadTerm:
+    """One load evaluated at N positions: ``force`` (N, 2) at ``local`` point of ``link`` and a
+    ``moment`` (N,) on the link. ``kind`` is "gravity", "external" or "inertia"."""
+
+    link: str
+    local: tuple[float, float]
+    force: np.ndarray
+    moment: np.ndarray
+    kind: str = "external"
+    label: str = ""
+
+
+# ----------------------------------------------------------------------------------------------
+# reading [loads] from a scheme
+# ----------------------------------------------------------------------------------------------
+
+
+def _diagram(mech: Mechanism, raw: Any, quantity: str, where: str, problems: list[str]):
+    if not isinstance(raw, Mapping):
+        problems.append(f"{where}: diagram must be a table, got {raw!r}")
+        return None
+    known = {"along", "working", "fractions", "values", "opposes", "idle_fractions", "idle_values"}
+    bad = set(raw) - known
+    if bad:
+        problems.append(f"{where}: unknown diagram keys {sorted(bad)} (known: {sorted(known)})")
+    working = {"+": 1, "-": -1, 1: 1, -1: -1}.get(raw.get("working"))
+    if working is None:
+        problems.append(f"{where}: diagram 'working' must be \"+\" or \"-\" (the direction of "
+                        f"{quantity} on the working stroke), got {raw.get('working')!r}")
+        return None
+    curves = []
+    for fk, vk in (("fractions", "values"), ("idle_fractions", "idle_values")):
+        fr, vals = raw.get(fk, []), raw.get(vk, [])
+        if fk == "idle_fractions" and not fr and not vals:
+            curves.append(((), ()))
+            continue
+        if not (isinstance(fr, list) and isinstance(vals, list) and len(fr) == len(vals) >= 2
+                and all(_is_number(x) for x in fr + vals)):
+            problems.append(f"{where}: diagram '{fk}' and '{vk}' must be lists of numbers of the same "
+                            f"length >= 2, got {fr!r} and {vals!r}")
+            return None
+        if fr[0] != 0 or fr[-1] != 1 or any(b <= a for a, b in zip(fr, fr[1:])):
+            problems.append(f"{where}: diagram '{fk}' must increase from 0 to 1 (fractions of the "
+                            f"stroke), got {fr}")
+            return None
+        if any(v < 0 for v in vals):
+            problems.append(f"{where}: diagram '{vk}' are magnitudes and must be >= 0 (the sign "
+                            f"comes from 'opposes'), got {vals}")
+            return None
+        curves.append((tuple(map(float, fr)), tuple(map(float, vals))))
+    opposes = raw.get("opposes", True)
+    if not isinstance(opposes, bool):
+        problems.append(f"{where}: diagram 'opposes' must be true or false, got {opposes!r}")
+        return None
+    diagram = StrokeDiagram(quantity, working, *curves[0], opposes, *curves[1])
+    try:
+        ext = extreme_positions(mech, quantity)
+    except ValueError as exc:
+        problems.append(f"{where}: {exc}")
+        return None
+    if ext.stroke <= 1e-9 * mech.size:
+        problems.append(f"{where}: the working direction {raw.get('working')!r} is never taken: "
+                        f"{quantity} does not move (stroke {ext.stroke:.3g})")
+        return None
+    return diagram
+
+
+def _vector_or_none(raw):
+    if isinstance(raw, list) and len(raw) == 2 and all(_is_number(v) for v in raw):
+        return (float(raw[0]), float(raw[1]))
+    return None
+
+
+def parse_loads(mech: Mechanism, raw: Mapping[str, Any] | None) -> tuple[Loads, list[str]]:
+    """Loads and the list of problems from a scheme's ``[loads]`` table."""
+    problems: list[str] = []
+    raw = raw or {}
+    if not isinstance(raw, Mapping):
+        return Loads(), [f"expected a table, got {raw!r}"]
+    bad = set(raw) - {"gravity", "forces", "moments"}
+    if bad:
+        problems.append(f"unknown keys {sorted(bad)} (known: ['forces', 'gravity', 'moments'])")
+    gravity = STANDARD_GRAVITY
+    if "gravity" in raw:
+        g = _vector_or_none(raw["gravity"])
+        if g is None:
+            problems.append(f"gravity must be [gx, gy] in m/s^2, got {raw['gravity']!r}")
+        else:
+            gravity = g
+    forces, moments = [], []
+    for i, spec in enumerate(raw.get("forces", [])):
+        where = f"forces[{i}]"
+        if not isinstance(spec, Mapping):
+            problems.append(f"{where}: expected a table, got {spec!r}")
+            continue
+        bad = set(spec) - {"point", "link", "force", "diagram"}
+        if bad:
+            problems.append(f"{where}: unknown keys {sorted(bad)}")
+        point = spec.get("point")
+        where = f"forces[{i}] (point {point!r})"
+        owners = [k for k in mech.point_links(point) if k != mech.frame] if isinstance(point, str) else []
+        link = spec.get("link")
+        if not owners:
+            problems.append(f"{where}: unknown point {point!r} (points of moving links: "
+                            f"{sorted({p for k in mech.moving_links for p in mech.links[k].points})})")
+            continue
+        if link is None:
+            if len(owners) > 1:
+                problems.append(f"{where}: point {point!r} is on links {owners}: say which one the force "
+                                "acts on with link = \"...\"")
+                continue
+            link = owners[0]
+        elif link not in owners:
+            problems.append(f"{where}: link {link!r} has no point {point!r} (links with it: {owners})")
+            continue
+        if ("force" in spec) == ("diagram" in spec):
+            problems.append(f"{where}: give exactly one of 'force' = [Fx, Fy] or 'diagram' = {{...}}")
+            continue
+        if "force" in spec:
+            vec = _vector_or_none(spec["force"])
+            if vec is None:
+                problems.append(f"{where}: force must be [Fx, Fy] in N, got {spec['force']!r}")
+                continue
+            forces.append(PointForce(point, link, vec))
+        else:
+            along = spec["diagram"].get("along") if isinstance(spec["diagram"], Mapping) else None
+            if along not in ("x", "y"):
+                problems.append(f"{where}: diagram 'along' must be \"x\" or \"y\", got {along!r}")
+                continue
+            d = _diagram(mech, spec["diagram"], f"{point}.{along}", where, problems)
+            if d is not None:
+                forces.append(PointForce(point, link, d))
+    for i, spec in enumerate(raw.get("moments", [])):
+        where = f"moments[{i}]"
+        if not isinstance(spec, Mapping):
+            problems.append(f"{where}: expected a table, got {spec!r}")
+            continue
+        link = spec.get("link")
+        where = f"moments[{i}] (link {link!r})"
+        if link not in mech.moving_links:
+            problems.append(f"{where}: unknown moving link {link!r} (moving links: {mech.moving_links})")
+            continue
+        if ("moment" in spec) == ("diagram" in spec):
+            problems.append(f"{where}: give exactly one of 'moment' (N m) or 'diagram' = {{...}}")
+            continue
+        if "moment" in spec:
+            if not _is_number(spec["moment"]):
+                problems.append(f"{where}: moment must be a number (N m), got {spec['moment']!r}")
+                continue
+            moments.append(LinkMoment(link, float(spec["moment"])))
+        else:
+            d = _diagram(mech, spec["diagram"], f"{link}.theta", where, problems)
+            if d is not None:
+                moments.append(LinkMoment(link, d))
+    notes = tuple(f"link '{k}' declares no mass: treated as massless" for k in mech.moving_links
+                  if not mech.links[k].mass_declared)
+    return Loads(gravity, tuple(forces), tuple(moments), notes), problems
+
+
+def loads_of(mech: Mechanism) -> Loads:
+    """The loads a mechanism declares (``[loads]`` of its scheme; gravity alone by default)."""
+    loads, problems = parse_loads(mech, mech.extra.get("loads"))
+    if problems:
+        from .errors import SchemeError
+
+        raise SchemeError([f"mechanism '{mech.name}' loads: {p}" for p in problems])
+    return loads
+
+
+SECTION_VALIDATORS["loads"] = lambda mech, raw: parse_loads(mech, raw)[1]
+
+
+# ----------------------------------------------------------------------------------------------
+# evaluating loads over a motion
+# ----------------------------------------------------------------------------------------------
+
+
+def _per_position(value: ArrayLike, n: int, shape: tuple[int, ...], what: str) -> np.ndarray:
+    arr = np.asarray(value, dtype=float)
+    try:
+        return np.broadcast_to(arr, (n, *shape)).copy()
+    except ValueError:
+        raise ValueError(f"{what}: expected a constant of shape {shape} or per-position values of "
+                         f"shape {(n, *shape)}, got shape {arr.shape}") from None
+
+
+def evaluate_loads(motion: Motion, loads: Loads, ends: ArrayLike | None = None) -> list[LoadTerm]:
+    """Gravity and external loads at the positions of ``motion`` (inertia not included).
+
+    ``ends`` (bool, per position) marks positions that end a cycle: at a stroke end they take the
+    value of the stroke that ends there (METHOD section 7).
+    """
+    mech, n = motion.mechanism, len(motion.phi)
+    rotation = 1.0 if motion.omega is None else float(np.sign(np.mean(motion.omega)) or 1.0)
+    terms = []
+    g = np.asarray(loads.gravity, dtype=float)
+    zero = np.zeros(n)
+    if np.any(g != 0):
+        for k in mech.moving_links:
+            link = mech.links[k]
+            if link.mass > 0:
+                terms.append(LoadTerm(k, link.center_of_mass, np.tile(link.mass * g, (n, 1)), zero,
+                                      "gravity", f"G{k}"))
+    for f in loads.forces:
+        local = mech.links[f.link].points[f.point]
+        if isinstance(f.force, StrokeDiagram):
+            value, d1, d2 = motion.quantity(f.force.quantity)
+            mag = f.force.magnitude(mech, value, d1, d2, rotation, ends)
+            axis = np.array([1.0, 0.0]) if f.force.quantity.endswith(".x") else np.array([0.0, 1.0])
+            vec = mag[:, None] * axis
+        else:
+            vec = _per_position(f.force, n, (2,), f"force at point '{f.point}'")
+        terms.append(LoadTerm(f.link, local, vec, zero, "external", f"F{f.point}"))
+    for m in loads.moments:
+        if isinstance(m.moment, StrokeDiagram):
+            value, d1, d2 = motion.quantity(m.moment.quantity)
+            mom = m.moment.magnitude(mech, value, d1, d2, rotation, ends)
+        else:
+            mom = _per_position(m.moment, n, (), f"moment on link '{m.link}'")
+        terms.append(LoadTerm(m.link, (0.0, 0.0), np.zeros((n, 2)), mom, "external", f"M{m.link}"))
+    return terms
+
+
+def inertia_terms(motion: Motion) -> list[LoadTerm]:
+    """Inertia forces ``-m a_S`` at the centres of mass and moments ``-J_S eps_k`` (METHOD 5).
+
+    Needs a motion analysed with ``omega`` (and ``eps``) and second analogs.
+    """
+    if motion.omega is None or motion.second is None:
+        raise ValueError("inertia loads need real accelerations: analyze(..., order=2, omega=..., eps=...)")
+    from assur.base import point_analogs
+
+    mech = motion.mechanism
+    w, e = motion.omega, motion.eps
+    terms = []
+    for k in mech.moving_links:
+        link = mech.links[k]
+        if link.mass == 0 and link.inertia == 0:
+            continue
+        d1, d2 = point_analogs(motion.poses[k], motion.first[k], motion.second[k], link.center_of_mass)
+        acc = d2 * (w**2)[:, None] + d1 * e[:, None]
+        eps_k = motion.second[k][:, 2] * w**2 + motion.first[k][:, 2] * e
+        terms.append(LoadTerm(k, link.center_of_mass, -link.mass * acc, -link.inertia * eps_k,
+                              "inertia", f"Fi{k}"))
+    return terms
+
+
+def generalized_loads(motion: Motion, terms: Sequence[LoadTerm]) -> dict[str, np.ndarray]:
+    """Sum of terms per link as ``(Fx, Fy, moment about the link's local origin)`` ``(N, 3)``."""
+    from assur.base import cross, rotate
+
+    n = len(motion.phi)
+    out = {k: np.zeros((n, 3)) for k in motion.mechanism.links}
+    for t in terms:
+        arm = rotate(motion.poses[t.link][:, 2], t.local)
+        out[t.link][:, :2] += t.force
+        out[t.link][:, 2] += cross(arm, t.force) + t.moment
+    return out
+

@@ -1,0 +1,179 @@
+"""Kinetostatic force analysis: pair reactions and the balancing moment (METHOD section 5).
+
+The groups are solved in reverse order of the structure ("from the farthest group") through the
+shared group protocol (the transposed constraint Jacobian, :meth:`assur.base.Group.reactions`);
+the reactions of a group's external pairs load the links it is attached to. The input link comes
+last: its frame reaction and the balancing moment ``M_b``.
+
+Convention: ``R[i, j]`` is the force that link j exerts on link i. For a pair declared with
+``links = [a, b]`` the reported force is ``R[a, b]`` (for a prismatic pair: the force of the slider
+on the guide, normal to the guide, and the moment of the slider on the guide about the slider's
+point).
+
+>>> import numpy as np, linkage
+>>> from linkage.kinetostatics import solve_reactions, virtual_power_residual
+>>> mech = linkage.load("four_bar")
+>>> motion = linkage.analyze(mech, np.radians([0.0, 45.0]), omega=10.0, eps=0.0)
+>>> reactions = solve_reactions(motion)
+>>> bool(np.all(virtual_power_residual(reactions) < 1e-9))
+True
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from assur.base import OK, PrismaticJoint, point_analogs
+
+from .forces import LoadTerm, Loads, evaluate_loads, generalized_loads, inertia_terms, loads_of
+from .kinematics import Motion
+
+__all__ = ["Reactions", "solve_reactions", "virtual_power_residual"]
+
+
+@dataclass(frozen=True)
+class Reactions:
+    """Reactions in every pair and the balancing moment at N positions.
+
+    Attributes
+    ----------
+    motion : Motion
+    multipliers : dict of pair name -> ndarray (N, 2)
+        The group solvers' Lagrange multipliers (see :class:`assur.base.RevoluteJoint` and
+        :class:`assur.base.PrismaticJoint`).
+    balancing_moment : ndarray (N,)
+        ``M_b``, the moment to apply to the input link for the given motion, N m (CCW positive).
+    terms : list of LoadTerm
+        The applied and inertia loads used.
+    notes : tuple of str
+    """
+
+    motion: Motion
+    multipliers: dict[str, np.ndarray]
+    balancing_moment: np.ndarray
+    terms: list[LoadTerm]
+    notes: tuple[str, ...] = ()
+
+    def force(self, pair: str) -> np.ndarray:
+        """``R[a, b]`` ``(N, 2)`` for the pair declared with ``links = [a, b]``, N."""
+        joint = self.motion.joints[pair]
+        lam = self.multipliers[pair]
+        if isinstance(joint, PrismaticJoint):
+            u, n, *_ = joint.frame(self.motion.poses)
+            return -lam[:, :1] * n
+        return lam
+
+    def moment(self, pair: str) -> np.ndarray:
+        """Prismatic pair: moment of the slider on the guide about the slider's point, N m."""
+        if not isinstance(self.motion.joints[pair], PrismaticJoint):
+            raise ValueError(f"pair '{pair}' is revolute: its reaction is a force only")
+        return -self.multipliers[pair][:, 1]
+
+    def on(self, i: str, j: str) -> np.ndarray:
+        """``R[i, j]``: the force that link j exerts on link i (summed over pairs joining them)."""
+        total = None
+        for name, pair in self.motion.mechanism.pairs.items():
+            if set(pair.links) == {i, j} and name in self.multipliers:
+                f = self.force(name) * (1.0 if pair.links[0] == i else -1.0)
+                total = f if total is None else total + f
+        if total is None:
+            raise ValueError(f"no pair joins links '{i}' and '{j}'")
+        return total
+
+    def magnitude(self, pair: str) -> np.ndarray:
+        return np.hypot(*self.force(pair).T)
+
+    def direction_deg(self, pair: str) -> np.ndarray:
+        """Direction angle of ``R[a, b]``, deg CCW from +x."""
+        f = self.force(pair)
+        return np.degrees(np.arctan2(f[:, 1], f[:, 0]))
+
+    def columns(self, full: bool = False) -> dict[str, np.ndarray]:
+        """Table: ``phi_deg``, ``balancing_moment``, per pair ``K.R`` (magnitude, N) and
+        ``K.angle_deg``; with ``full`` also ``K.Rx``, ``K.Ry`` and, for prismatic pairs, ``K.M``."""
+        cols = {"phi_deg": np.degrees(self.motion.phi), "balancing_moment": self.balancing_moment}
+        for name in sorted(self.multipliers):
+            cols[f"{name}.R"] = self.magnitude(name)
+            cols[f"{name}.angle_deg"] = self.direction_deg(name)
+            if full:
+                f = self.force(name)
+                cols[f"{name}.Rx"], cols[f"{name}.Ry"] = f[:, 0], f[:, 1]
+                if isinstance(self.motion.joints[name], PrismaticJoint):
+                    cols[f"{name}.M"] = self.moment(name)
+        return cols
+
+
+def solve_reactions(
+    motion: Motion,
+    loads: Loads | None = None,
+    *,
+    inertia: bool = True,
+    ends: ArrayLike | None = None,
+) -> Reactions:
+    """Reactions in every pair and the balancing moment, group by group from the farthest.
+
+    Parameters
+    ----------
+    motion : Motion
+        Kinematics with second analogs; with ``omega`` (and ``eps``) when ``inertia`` is on.
+    loads : Loads, optional
+        Default: the loads the mechanism declares (gravity alone when it declares none).
+    inertia : bool
+        Include inertia forces and moments (needs ``motion.omega``).
+    ends : array_like of bool, optional
+        Positions that end a cycle (force diagrams take their end-of-stroke value there).
+    """
+    mech, structure = motion.mechanism, motion.structure
+    if motion.second is None:
+        raise ValueError("reactions need a motion analysed with order=2")
+    loads = loads_of(mech) if loads is None else loads
+    terms = evaluate_loads(motion, loads, ends)
+    if inertia and motion.omega is not None:
+        terms += inertia_terms(motion)
+    applied = generalized_loads(motion, terms)
+    multipliers: dict[str, np.ndarray] = {}
+    for group in reversed(structure.groups):
+        lam, transmitted = group.reactions(motion.poses, applied)
+        multipliers.update(lam)
+        for link, load in transmitted.items():
+            applied[link] = applied[link] + load
+    (link,) = structure.inputs
+    joint = structure.input_joints[link]
+    jac = joint.jacobian(motion.poses)[link]  # (N, 2, 3)
+    system = np.concatenate([np.transpose(jac, (0, 2, 1)), np.tile([0.0, 0.0, 1.0], (len(jac), 1))[..., None]],
+                            axis=2)
+    bad = motion.status != OK
+    system[bad] = np.eye(3)
+    solution = np.linalg.solve(system, -applied[link][..., None])[..., 0]
+    multipliers[joint.name] = solution[:, :2]
+    balancing = solution[:, 2]
+    if bad.any():
+        balancing = np.where(bad, np.nan, balancing)
+        multipliers = {k: np.where(bad[:, None], np.nan, v) for k, v in multipliers.items()}
+    notes = loads.notes + (() if inertia and motion.omega is not None or not inertia else
+                           ("no speed given: inertia loads are zero (static analysis)",))
+    return Reactions(motion, multipliers, balancing, terms, notes)
+
+
+def virtual_power_residual(reactions: Reactions) -> np.ndarray:
+    """Relative residual of the virtual-power balance (Zhukovsky's lever), per position.
+
+    ``(M_b omega + sum(F . v_P + M omega_k)) / (|M_b omega| + sum(|F . v_P| + |M omega_k|))`` over
+    the applied and inertia loads; reactions of ideal pairs do no work, so it is ~0 when the
+    reactions are right. Velocities use ``omega = 1`` when the motion has none.
+    """
+    motion = reactions.motion
+    omega = np.ones(len(motion.phi)) if motion.omega is None else motion.omega
+    (link,) = motion.structure.inputs
+    powers = [reactions.balancing_moment * omega]
+    for t in reactions.terms:
+        pose, first = motion.poses[t.link], motion.first[t.link]
+        v, _ = point_analogs(pose, first, None, t.local)
+        powers.append((np.einsum("ni,ni->n", t.force, v) + t.moment * first[:, 2]) * omega)
+    powers = np.array(powers)
+    scale = np.sum(np.abs(powers), axis=0)
+    return np.abs(np.sum(powers, axis=0)) / np.where(scale > 0, scale, 1.0)
+
