@@ -12,6 +12,7 @@ from .kinematics import Motion, analyze, structure_of
 from .model import Mechanism, MechanismBuilder
 from .scheme import dumps, load, loads, save, shipped_schemes
 from .structure import decompose, mobility
+from . import forces, dynamics  # noqa: F401  (register the [loads] and [dynamics] sections)
 
 __all__ = [
     "AssemblyError", "LinkageError", "SchemeError", "StructureError", "Mechanism",

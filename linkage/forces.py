@@ -40,6 +40,7 @@ from .scheme import SECTION_VALIDATORS
 
 __all__ = [
     "StrokeDiagram",
+    "CycleTable",
     "PointForce",
     "LinkMoment",
     "Loads",
@@ -109,12 +110,38 @@ class StrokeDiagram:
 
 
 @dataclass(frozen=True)
+class CycleTable:
+    """Load values at the positions 1..n+1 of the machine's cycle table (METHOD section 1).
+
+    Position 1 is the start of the cycle (``start``: "extreme", "max", "min" or degrees) and
+    positions follow the rotation; between positions the value is linear in the cycle angle, and
+    position n+1 (the cycle's end, same angle as position 1) may carry its own value.
+    """
+
+    quantity: str
+    values: tuple[float, ...]
+    start: Any = "extreme"
+    rotation: int = 1
+
+    def magnitude(self, mech: Mechanism, phi: np.ndarray, ends=None) -> np.ndarray:
+        from .extremes import table_angles
+
+        n = len(self.values) - 1
+        phi0 = table_angles(mech, 1, self.start, self.rotation)[0]
+        psi = np.mod(self.rotation * (phi - phi0), 2 * np.pi)
+        psi = np.where(np.isclose(psi, 2 * np.pi, rtol=0, atol=1e-9), 0.0, psi)
+        if ends is not None:
+            psi = np.where(np.asarray(ends, bool) & (psi < 1e-9), 2 * np.pi, psi)
+        return np.interp(psi, np.linspace(0, 2 * np.pi, n + 1), self.values)
+
+
+@dataclass(frozen=True)
 class PointForce:
     """A force at a named point of a link: a constant vector, per-position vectors, or a diagram."""
 
     point: str
     link: str
-    force: Any  # (2,), (N, 2) or StrokeDiagram
+    force: Any  # (2,), (N, 2), StrokeDiagram or CycleTable
 
 
 @dataclass(frozen=True)
@@ -148,7 +175,8 @@ class Loads:
 @dataclass(frozen=True)
 class LoadTerm:
     """One load evaluated at N positions: ``force`` (N, 2) at ``local`` point of ``link`` and a
-    ``moment`` (N,) on the link. ``kind`` is "gravity", "external" or "inertia"."""
+    ``moment`` (N,) on the link. ``kind`` is "gravity", "external" (resisting or neutral),
+    "driving" (a diagram declared with ``opposes = false``) or "inertia"."""
 
     link: str
     local: tuple[float, float]
@@ -213,6 +241,26 @@ def _diagram(mech: Mechanism, raw: Any, quantity: str, where: str, problems: lis
     return diagram
 
 
+def _cycle_table(mech: Mechanism, spec, point: str, where: str, problems: list[str]):
+    """A :class:`CycleTable` from ``cycle = [...]`` and ``along``; the cycle (start, rotation) is
+    the one the mechanism's ``[dynamics]`` declares."""
+    along, values = spec.get("along"), spec.get("cycle")
+    if along not in ("x", "y"):
+        problems.append(f"{where}: a cycle table needs along = \"x\" or \"y\", got {along!r}")
+        return None
+    if not (isinstance(values, list) and len(values) >= 3 and all(_is_number(v) for v in values)):
+        problems.append(f"{where}: cycle must list the values (N) at positions 1..n+1, got {values!r}")
+        return None
+    dyn = mech.extra.get("dynamics")
+    speed = dyn.get("mean_speed", dyn.get("mean_rpm")) if isinstance(dyn, Mapping) else None
+    if not _is_number(speed) or speed == 0:
+        problems.append(f"{where}: a cycle table needs the direction of rotation: declare [dynamics] "
+                        "mean_speed (rad/s) or mean_rpm, signed")
+        return None
+    start = dyn.get("start_deg", "extreme")
+    return CycleTable(f"{point}.{along}", tuple(float(v) for v in values), start, int(np.sign(speed)))
+
+
 def _vector_or_none(raw):
     if isinstance(raw, list) and len(raw) == 2 and all(_is_number(v) for v in raw):
         return (float(raw[0]), float(raw[1]))
@@ -241,7 +289,7 @@ def parse_loads(mech: Mechanism, raw: Mapping[str, Any] | None) -> tuple[Loads, 
         if not isinstance(spec, Mapping):
             problems.append(f"{where}: expected a table, got {spec!r}")
             continue
-        bad = set(spec) - {"point", "link", "force", "diagram"}
+        bad = set(spec) - {"point", "link", "force", "diagram", "cycle", "along"}
         if bad:
             problems.append(f"{where}: unknown keys {sorted(bad)}")
         point = spec.get("point")
@@ -261,10 +309,15 @@ def parse_loads(mech: Mechanism, raw: Mapping[str, Any] | None) -> tuple[Loads, 
         elif link not in owners:
             problems.append(f"{where}: link {link!r} has no point {point!r} (links with it: {owners})")
             continue
-        if ("force" in spec) == ("diagram" in spec):
-            problems.append(f"{where}: give exactly one of 'force' = [Fx, Fy] or 'diagram' = {{...}}")
+        if sum(k in spec for k in ("force", "diagram", "cycle")) != 1:
+            problems.append(f"{where}: give exactly one of 'force' = [Fx, Fy], 'diagram' = {{...}} or "
+                            "'cycle' = [values at the cycle's positions]")
             continue
-        if "force" in spec:
+        if "cycle" in spec:
+            table = _cycle_table(mech, spec, f"{point}", where, problems)
+            if table is not None:
+                forces.append(PointForce(point, link, table))
+        elif "force" in spec:
             vec = _vector_or_none(spec["force"])
             if vec is None:
                 problems.append(f"{where}: force must be [Fx, Fy] in N, got {spec['force']!r}")
@@ -351,21 +404,28 @@ def evaluate_loads(motion: Motion, loads: Loads, ends: ArrayLike | None = None) 
                                       "gravity", f"G{k}"))
     for f in loads.forces:
         local = mech.links[f.link].points[f.point]
-        if isinstance(f.force, StrokeDiagram):
-            value, d1, d2 = motion.quantity(f.force.quantity)
-            mag = f.force.magnitude(mech, value, d1, d2, rotation, ends)
+        kind = "external"
+        if isinstance(f.force, (StrokeDiagram, CycleTable)):
+            if isinstance(f.force, StrokeDiagram):
+                value, d1, d2 = motion.quantity(f.force.quantity)
+                mag = f.force.magnitude(mech, value, d1, d2, rotation, ends)
+                kind = "external" if f.force.opposes else "driving"
+            else:
+                mag = f.force.magnitude(mech, motion.phi, ends)
             axis = np.array([1.0, 0.0]) if f.force.quantity.endswith(".x") else np.array([0.0, 1.0])
             vec = mag[:, None] * axis
         else:
             vec = _per_position(f.force, n, (2,), f"force at point '{f.point}'")
-        terms.append(LoadTerm(f.link, local, vec, zero, "external", f"F{f.point}"))
+        terms.append(LoadTerm(f.link, local, vec, zero, kind, f"F{f.point}"))
     for m in loads.moments:
+        kind = "external"
         if isinstance(m.moment, StrokeDiagram):
             value, d1, d2 = motion.quantity(m.moment.quantity)
             mom = m.moment.magnitude(mech, value, d1, d2, rotation, ends)
+            kind = "external" if m.moment.opposes else "driving"
         else:
             mom = _per_position(m.moment, n, (), f"moment on link '{m.link}'")
-        terms.append(LoadTerm(m.link, (0.0, 0.0), np.zeros((n, 2)), mom, "external", f"M{m.link}"))
+        terms.append(LoadTerm(m.link, (0.0, 0.0), np.zeros((n, 2)), mom, kind, f"M{m.link}"))
     return terms
 
 

@@ -1,0 +1,694 @@
+"""Machine dynamics of a one-degree-of-freedom mechanism (METHOD section 6).
+
+Three ways to the crank's law of motion, all on any mechanism the graph can express:
+
+- :func:`course_method` -- the course method: constant driving moment from the cycle balance
+  (trapezoid on the table positions), Mertsalov's flywheel, omega and eps by the course formulas;
+- :func:`exact_method` -- the energy equation without Mertsalov's approximation on a fine grid,
+  and the exact flywheel for the same coefficient of speed fluctuation;
+- :func:`steady_state` / :func:`simulate` -- the equation of motion with a motor characteristic
+  (:mod:`linkage.motors`), integrated with ``scipy.integrate.solve_ivp``: a start-up transient
+  over K cycles, and the periodic steady state by shooting.
+
+:func:`run_dynamics` runs the whole course pipeline in one call: reduced characteristics, law of
+motion, then the kinetostatics under the real motion and the coefficient of dynamics
+``k_dyn = max|M_b| / |M_d|`` (this project's definition: the peak torque on the drive shaft over
+the mean driving torque).
+
+All reduced quantities refer to ``psi = s phi`` with ``s = sign(omega_m)``: a reduced moment is
+positive when it drives, speeds ``w = |omega|`` are positive.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any, Mapping
+
+import numpy as np
+from scipy.integrate import solve_ivp
+from scipy.interpolate import CubicSpline
+from scipy.optimize import brentq
+
+from .errors import LinkageError
+from .extremes import table_angles
+from .forces import loads_of
+from .kinematics import analyze
+from .kinetostatics import solve_reactions
+from .model import Mechanism, _is_number
+from .motors import RPM, ConstantMotor, motor_from_spec
+from .reduced import Reduced, reduced_characteristics
+from .scheme import SECTION_VALIDATORS
+
+__all__ = [
+    "DynamicsError",
+    "DynamicsSpec",
+    "LawOfMotion",
+    "Transient",
+    "dynamics_of",
+    "course_method",
+    "exact_method",
+    "simulate",
+    "steady_state",
+    "run_dynamics",
+    "DynamicsReport",
+]
+
+
+class DynamicsError(LinkageError):
+    """The machine stalls, runs away, or the steady state cannot be found."""
+
+
+# ----------------------------------------------------------------------------------------------
+# inputs
+# ----------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class DynamicsSpec:
+    """Dynamics inputs of a machine (the ``[dynamics]`` section of a scheme).
+
+    Attributes
+    ----------
+    mean_speed : float
+        Mean angular velocity of the input link, rad/s, signed (negative: clockwise).
+    delta : float or None
+        Target coefficient of speed fluctuation ``(omega_max - omega_min) / omega_m``.
+    positions : int
+        Table positions per revolution (course method).
+    start : "extreme" or float
+        Start of the cycle: the output's extreme position, or an input angle in degrees.
+    inertia_0 : float
+        Constant inertia reduced to the input besides the input link's own, kg m^2.
+    rotors : tuple of (inertia, ratio)
+        Rotors and gears, reduced as ``J U^2`` (U = rotor speed / input speed).
+    flywheel : float
+        An installed flywheel on the input shaft, kg m^2.
+    motor : callable or None
+        Motor characteristic reduced to the input (:mod:`linkage.motors`).
+    initial_speed : float or None
+        Initial |omega| of the start-up transient, rad/s.
+    cycles : int
+        Cycles of the start-up transient.
+    """
+
+    mean_speed: float
+    delta: float | None = None
+    positions: int = 12
+    start: Any = "extreme"
+    inertia_0: float = 0.0
+    rotors: tuple[tuple[float, float], ...] = ()
+    flywheel: float = 0.0
+    motor: Any = None
+    initial_speed: float | None = None
+    cycles: int = 10
+
+    @property
+    def rotation(self) -> int:
+        return 1 if self.mean_speed > 0 else -1
+
+    @property
+    def constant_inertia(self) -> float:
+        """Declared constant inertia at the input besides the input link's own, kg m^2."""
+        return self.inertia_0 + sum(j * u * u for j, u in self.rotors) + self.flywheel
+
+
+def parse_dynamics(mech: Mechanism, raw: Mapping[str, Any] | None) -> tuple[DynamicsSpec | None, list[str]]:
+    """The dynamics inputs and the list of problems from a scheme's ``[dynamics]`` table."""
+    if raw is None:
+        return None, []
+    if not isinstance(raw, Mapping):
+        return None, [f"expected a table, got {raw!r}"]
+    known = {"mean_speed", "mean_rpm", "delta", "positions", "start_deg", "inertia_0", "rotors",
+             "flywheel", "motor", "initial_speed", "initial_rpm", "cycles"}
+    problems = []
+    if set(raw) - known:
+        problems.append(f"unknown keys {sorted(set(raw) - known)} (known: {sorted(known)})")
+    if ("mean_speed" in raw) == ("mean_rpm" in raw):
+        problems.append("give exactly one of mean_speed (rad/s, signed) or mean_rpm (signed)")
+        return None, problems
+    speed = raw.get("mean_speed", raw.get("mean_rpm"))
+    if not _is_number(speed) or speed == 0:
+        problems.append(f"mean speed must be a nonzero number (its sign is the rotation), got {speed!r}")
+        return None, problems
+    speed = float(speed) * (RPM if "mean_rpm" in raw else 1.0)
+    args: dict[str, Any] = {"mean_speed": speed}
+    for key, strict in (("delta", True), ("inertia_0", False), ("flywheel", False)):
+        if key in raw:
+            v = raw[key]
+            if not _is_number(v) or v < 0 or (strict and v == 0):
+                problems.append(f"{key} must be a number {'> 0' if strict else '>= 0'}, got {v!r}")
+            else:
+                args[key] = float(v)
+    for key in ("positions", "cycles"):
+        if key in raw:
+            v = raw[key]
+            if not isinstance(v, int) or isinstance(v, bool) or v < 1:
+                problems.append(f"{key} must be a positive integer, got {v!r}")
+            else:
+                args[key] = v
+    if "start_deg" in raw:
+        if not _is_number(raw["start_deg"]):
+            problems.append(f"start_deg must be a number, got {raw['start_deg']!r}")
+        else:
+            args["start"] = float(raw["start_deg"])
+    elif mech.output is None:
+        problems.append("the cycle starts at the output's extreme position: declare an output or start_deg")
+    rotors = []
+    for i, r in enumerate(raw.get("rotors", [])):
+        if not (isinstance(r, Mapping) and _is_number(r.get("inertia")) and r["inertia"] >= 0
+                and _is_number(r.get("ratio", 1.0))):
+            problems.append(f"rotors[{i}]: expected {{inertia = J (kg m^2), ratio = U}}, got {r!r}")
+        else:
+            rotors.append((float(r["inertia"]), float(r.get("ratio", 1.0))))
+    args["rotors"] = tuple(rotors)
+    if "initial_speed" in raw or "initial_rpm" in raw:
+        v = raw.get("initial_speed", raw.get("initial_rpm"))
+        if not _is_number(v) or v <= 0:
+            problems.append(f"initial speed must be a number > 0 (|omega| at the start), got {v!r}")
+        else:
+            args["initial_speed"] = float(v) * (RPM if "initial_rpm" in raw else 1.0)
+    if "motor" in raw:
+        motor, motor_problems = motor_from_spec(raw["motor"])
+        problems += motor_problems
+        args["motor"] = motor
+    return (DynamicsSpec(**args) if not problems else None), problems
+
+
+def dynamics_of(mech: Mechanism) -> DynamicsSpec:
+    """The dynamics inputs a mechanism declares; ``ValueError`` when it declares none."""
+    spec, problems = parse_dynamics(mech, mech.extra.get("dynamics"))
+    if problems:
+        from .errors import SchemeError
+
+        raise SchemeError([f"mechanism '{mech.name}' dynamics: {p}" for p in problems])
+    if spec is None:
+        raise ValueError(f"mechanism '{mech.name}' declares no [dynamics] section (mean speed, delta, ...)")
+    return spec
+
+
+SECTION_VALIDATORS["dynamics"] = lambda mech, raw: parse_dynamics(mech, raw)[1]
+
+
+# ----------------------------------------------------------------------------------------------
+# results
+# ----------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class LawOfMotion:
+    """The crank's law of motion over one cycle, at the table positions.
+
+    Attributes
+    ----------
+    method : str
+        "course", "exact" or "ode".
+    phi : ndarray (n+1,)
+        Table input angles, rad (``phi_i = phi0 + s (i-1) 2 pi / n``).
+    reduced : Reduced
+        Reduced characteristics at the table positions (with the constant inertia in use).
+    driving_moment : float
+        Constant (or cycle-mean, for "ode") driving moment, N m.
+    required_constant_inertia : float
+        Constant inertia at the crank needed for ``delta``: Mertsalov's ``I'`` (course) or
+        ``I_0 + I_fw`` of the exact solution, kg m^2.
+    flywheel_inertia : float or None
+        Flywheel to add, kg m^2; None when none is needed.
+    delta_actual : float
+        Coefficient of speed fluctuation of the resulting motion.
+    omega, eps : ndarray (n+1,)
+        Angular velocity (rad/s, signed) and acceleration (rad/s^2) of the crank.
+    details : dict
+        Method-specific intermediate results (work of resistance, energy changes ...).
+    """
+
+    method: str
+    phi: np.ndarray
+    reduced: Reduced
+    driving_moment: float
+    required_constant_inertia: float
+    flywheel_inertia: float | None
+    delta_actual: float
+    omega: np.ndarray
+    eps: np.ndarray
+    details: dict = field(default_factory=dict)
+
+    @property
+    def mean_speed_actual(self) -> float:
+        return float(np.sign(self.omega[0]) * (np.max(np.abs(self.omega)) + np.min(np.abs(self.omega))) / 2)
+
+
+def _cycle(mech: Mechanism, spec: DynamicsSpec, positions: int | None = None):
+    n = positions or spec.positions
+    phi = table_angles(mech, n, spec.start, spec.rotation)
+    ends = np.zeros(n + 1, bool)
+    ends[-1] = True
+    return phi, ends
+
+
+def _eps(reduced: Reduced, driving: float | np.ndarray, inertia: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """``s (M_d + M_c - dI/dpsi w^2 / 2) / I`` (METHOD section 6)."""
+    return reduced.rotation * (driving + reduced.moment - 0.5 * reduced.inertia_derivative * w**2) / inertia
+
+
+# ----------------------------------------------------------------------------------------------
+# the course method
+# ----------------------------------------------------------------------------------------------
+
+
+def course_method(mech: Mechanism, spec: DynamicsSpec | None = None, *, positions: int | None = None,
+                  delta: float | None = None, mean_speed: float | None = None) -> LawOfMotion:
+    """Mertsalov's method on the table positions (METHOD section 6).
+
+    ``positions``, ``delta`` and ``mean_speed`` override the declared inputs.
+    """
+    spec = _override(mech, spec, delta, mean_speed)
+    if spec.delta is None:
+        raise ValueError("the course method needs delta (the coefficient of speed fluctuation)")
+    phi, ends = _cycle(mech, spec, positions)
+    n = len(phi) - 1
+    red = reduced_characteristics(mech, phi, spec.rotation, extra_inertia=spec.constant_inertia, ends=ends)
+    step = 2 * np.pi / n
+    work = np.concatenate([[0.0], np.cumsum((red.moment[1:] + red.moment[:-1]) / 2 * step)])
+    driving = -work[-1] / (2 * np.pi)
+    psi = np.arange(n + 1) * step
+    energy = driving * psi + work  # Delta T
+    wm = abs(spec.mean_speed)
+    energy_links = red.inertia_variable * wm**2 / 2  # T''
+    energy_flywheel = energy - energy_links  # Delta T'
+    swing = float(np.max(energy_flywheel) - np.min(energy_flywheel))
+    required = swing / (spec.delta * wm**2)
+    flywheel = required - red.inertia_constant
+    constant = max(required, red.inertia_constant)
+    delta_actual = spec.delta if flywheel > 0 else swing / (red.inertia_constant * wm**2)
+    mean_energy = constant * wm**2 / 2
+    energy_total = mean_energy + energy_flywheel - (np.max(energy_flywheel) + np.min(energy_flywheel)) / 2
+    w = np.sqrt(2 * energy_total / constant)
+    inertia = constant + red.inertia_variable
+    reduced = _with_constant(red, constant)
+    return LawOfMotion("course", phi, reduced, float(driving), float(required),
+                       float(flywheel) if flywheel > 0 else None, float(delta_actual),
+                       spec.rotation * w, _eps(red, driving, inertia, w),
+                       {"work_resistance": work, "energy_change": energy, "energy_links": energy_links,
+                        "energy_flywheel": energy_flywheel, "energy_swing": swing})
+
+
+def _with_constant(red: Reduced, constant: float) -> Reduced:
+    return Reduced(red.phi, red.rotation, red.moment_resistance, red.moment_driving, float(constant),
+                   red.inertia_variable, red.inertia_derivative)
+
+
+def _override(mech, spec, delta, mean_speed) -> DynamicsSpec:
+    if spec is None:
+        if mech.extra.get("dynamics") is None and mean_speed is not None:
+            spec = DynamicsSpec(mean_speed=mean_speed)
+        else:
+            spec = dynamics_of(mech)
+    changes = {}
+    if delta is not None:
+        if not delta > 0:
+            raise ValueError(f"delta must be > 0, got {delta!r}")
+        changes["delta"] = float(delta)
+    if mean_speed is not None:
+        if mean_speed == 0:
+            raise ValueError("mean speed must be nonzero (its sign is the rotation)")
+        changes["mean_speed"] = float(mean_speed)
+    return _replace(spec, **changes)
+
+
+def _replace(spec: DynamicsSpec, **changes) -> DynamicsSpec:
+    from dataclasses import replace
+
+    return replace(spec, **changes)
+
+
+# ----------------------------------------------------------------------------------------------
+# the exact energy method
+# ----------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class _Cycle:
+    """Reduced characteristics on a fine grid over one cycle, with the energy change."""
+
+    psi: np.ndarray
+    reduced: Reduced
+    driving: float
+    energy: np.ndarray  # Delta T(psi) with the balancing constant driving moment
+
+
+def _fine_cycle(mech: Mechanism, spec: DynamicsSpec, samples: int) -> _Cycle:
+    n = spec.positions * max(1, math.ceil(samples / spec.positions))
+    phi, ends = _cycle(mech, spec, n)
+    red = reduced_characteristics(mech, phi, spec.rotation, extra_inertia=spec.constant_inertia, ends=ends)
+    psi = np.arange(n + 1) * 2 * np.pi / n
+    work = np.concatenate([[0.0], np.cumsum((red.moment[1:] + red.moment[:-1]) / 2 * np.diff(psi))])
+    driving = -work[-1] / (2 * np.pi)
+    return _Cycle(psi, red, float(driving), driving * psi + work)
+
+
+def _speeds(cycle: _Cycle, constant: float, mean: float):
+    """|omega|(psi) with the energy level chosen so that (max + min) / 2 = mean."""
+    inertia = constant + cycle.reduced.inertia_variable
+    low = -np.min(cycle.energy) + 1e-300
+
+    def mid(t0):
+        w = np.sqrt(2 * np.maximum(t0 + cycle.energy, 0.0) / inertia)
+        return (np.max(w) + np.min(w)) / 2 - mean
+
+    high = max(1.0, low) + np.max(inertia) * mean**2
+    while mid(high) < 0:
+        high *= 4
+    t0 = brentq(mid, low, high, xtol=1e-14 * high, rtol=1e-15)
+    return np.sqrt(2 * (t0 + cycle.energy) / inertia)
+
+
+def _delta(w: np.ndarray, mean: float) -> float:
+    return float((np.max(w) - np.min(w)) / mean)
+
+
+def exact_method(mech: Mechanism, spec: DynamicsSpec | None = None, *, positions: int | None = None,
+                 delta: float | None = None, mean_speed: float | None = None,
+                 samples: int = 3600) -> LawOfMotion:
+    """The energy equation solved without Mertsalov's approximation, on ``samples`` grid points.
+
+    The constant driving moment balances the cycle (trapezoid on the fine grid); the kinetic
+    energy ``T = T_0 + Delta T(psi)`` gives ``|omega| = sqrt(2 T / I(psi))`` with ``T_0`` such that
+    ``(omega_max + omega_min) / 2 = |omega_m|``; the flywheel is the added constant inertia that
+    makes ``delta`` equal the target (found by Brent's method).
+    """
+    spec = _override(mech, spec, delta, mean_speed)
+    if positions is not None:
+        spec = _replace(spec, positions=positions)
+    cycle = _fine_cycle(mech, spec, samples)
+    wm = abs(spec.mean_speed)
+    base = cycle.reduced.inertia_constant
+    delta_base = _delta(_speeds(cycle, base, wm), wm)
+    if spec.delta is None or delta_base <= spec.delta:
+        constant, flywheel = base, None
+    else:
+        high = base + 1.0
+        while _delta(_speeds(cycle, high, wm), wm) > spec.delta:
+            high = 2 * high + 1.0
+        constant = brentq(lambda c: _delta(_speeds(cycle, c, wm), wm) - spec.delta, base, high,
+                          xtol=1e-13 * high, rtol=1e-14)
+        flywheel = constant - base
+    w = _speeds(cycle, constant, wm)
+    stride = (len(cycle.psi) - 1) // spec.positions
+    pick = slice(None, None, stride)
+    red = _pick(cycle.reduced, pick, constant)
+    w_table = w[pick]
+    return LawOfMotion("exact", red.phi, red, cycle.driving, float(constant),
+                       None if flywheel is None else float(flywheel), _delta(w, wm),
+                       spec.rotation * w_table, _eps(red, cycle.driving, red.inertia, w_table),
+                       {"samples": len(cycle.psi) - 1})
+
+
+def _pick(red: Reduced, index, constant: float) -> Reduced:
+    return Reduced(red.phi[index], red.rotation, red.moment_resistance[index], red.moment_driving[index],
+                   float(constant), red.inertia_variable[index], red.inertia_derivative[index])
+
+
+# ----------------------------------------------------------------------------------------------
+# the equation of motion with a motor
+# ----------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Transient:
+    """Solution of the equation of motion: ``psi`` (rad from the cycle start), time ``t`` (s) and
+    ``omega`` (rad/s, signed) at the solver's output points, plus the dense solution ``sol``
+    (``sol(psi) -> [T, t]``, kinetic energy and time as functions of psi)."""
+
+    psi: np.ndarray
+    t: np.ndarray
+    omega: np.ndarray
+    sol: Any
+    message: str = ""
+
+
+class _Equation:
+    """``I(psi) w dw/dpsi + I'(psi) w^2 / 2 = M_d(w) + M(psi)`` in the energy form
+    ``dT/dpsi = M_d(w) + M(psi)`` with ``w = sqrt(2 T / I)``; ``dt/dpsi = 1 / w``."""
+
+    def __init__(self, mech: Mechanism, spec: DynamicsSpec, motor, constant: float, samples: int = 720):
+        cycle = _fine_cycle(mech, spec, samples)
+        psi = cycle.psi
+        inertia = constant + cycle.reduced.inertia_variable
+        inertia[-1] = inertia[0]
+        self.inertia = CubicSpline(psi, inertia, bc_type="periodic")
+        self.psi_grid, self.moment_grid = psi, cycle.reduced.moment
+        self.motor, self.rotation = motor, spec.rotation
+        self.cycle, self.constant = cycle, constant
+        self.scale = float(np.mean(inertia)) * spec.mean_speed**2 / 2
+
+    def moment(self, psi):
+        return np.interp(np.mod(psi, 2 * np.pi), self.psi_grid, self.moment_grid)
+
+    def speed(self, psi, energy):
+        return np.sqrt(2 * np.maximum(energy, 0.0) / self.inertia(np.mod(psi, 2 * np.pi)))
+
+    def rhs(self, psi, state):
+        energy = state[0]
+        w = self.speed(psi, energy)
+        return [float(self.motor(w) + self.moment(psi)), 1.0 / max(float(w), 1e-300)]
+
+
+def _integrate(eq: _Equation, energy0: float, cycles: float, rtol: float, atol: float | None,
+               speed_limit: float) -> Any:
+    scale = eq.scale
+
+    def stall(psi, y):
+        return y[0] - 1e-10 * scale
+
+    stall.terminal, stall.direction = True, -1
+
+    def runaway(psi, y):
+        return eq.speed(psi, y[0]) - speed_limit
+
+    runaway.terminal, runaway.direction = True, 1
+    return solve_ivp(eq.rhs, (0.0, 2 * np.pi * cycles), [energy0, 0.0], method="RK45", rtol=rtol,
+                     atol=[atol if atol is not None else 1e-10 * scale, 1e-10], dense_output=True,
+                     events=[stall, runaway], max_step=2 * np.pi / 90)
+
+
+def _raise_events(sol, eq: _Equation, what: str) -> None:
+    if sol.status == -1:
+        raise DynamicsError(f"{what}: the integration failed ({sol.message})")
+    if len(sol.t_events[0]):
+        psi = sol.t_events[0][0]
+        raise DynamicsError(f"{what}: the machine stalls (omega -> 0) at psi = {math.degrees(psi):.1f} deg "
+                            f"after {sol.y_events[0][0][1]:.3g} s: the motor cannot overcome the load")
+    if len(sol.t_events[1]):
+        psi = sol.t_events[1][0]
+        raise DynamicsError(f"{what}: the machine runs away (|omega| above the speed limit) at psi = "
+                            f"{math.degrees(psi):.1f} deg after {sol.y_events[1][0][1]:.3g} s")
+
+
+def _motor_of(spec: DynamicsSpec, driving: float):
+    return spec.motor if spec.motor is not None else ConstantMotor(driving)
+
+
+def _speed_limit(spec: DynamicsSpec, motor) -> float:
+    sync = getattr(motor, "synchronous_rpm", None)
+    limits = [abs(spec.mean_speed)]
+    if sync is not None:
+        limits.append(sync * RPM / motor.ratio)
+    if getattr(motor, "no_load_speed", None):
+        limits.append(motor.no_load_speed / motor.ratio)
+    return 10 * max(limits)
+
+
+def simulate(mech: Mechanism, spec: DynamicsSpec | None = None, *, initial_speed: float | None = None,
+             cycles: int | None = None, constant_inertia: float | None = None, rtol: float = 1e-8,
+             atol: float | None = None, samples: int = 720) -> Transient:
+    """Start-up transient from ``initial_speed`` (|omega|, rad/s) over ``cycles`` revolutions.
+
+    ``constant_inertia`` is the constant inertia at the crank (default: the declared one,
+    input link included). Raises :class:`DynamicsError` on stall or run-away.
+    """
+    spec = dynamics_of(mech) if spec is None else spec
+    w0 = initial_speed if initial_speed is not None else spec.initial_speed
+    if w0 is None or not w0 > 0:
+        raise ValueError(f"the transient needs an initial speed |omega| > 0 (rad/s), got {w0!r}")
+    constant = _default_constant(mech, spec) if constant_inertia is None else constant_inertia
+    eq = _Equation(mech, spec, None, constant, samples)
+    eq.motor = _motor_of(spec, eq.cycle.driving)
+    energy0 = float(eq.inertia(0.0)) * w0**2 / 2
+    sol = _integrate(eq, energy0, cycles or spec.cycles, rtol, atol, _speed_limit(spec, eq.motor))
+    _raise_events(sol, eq, f"mechanism '{mech.name}' transient")
+    w = eq.speed(sol.t, sol.y[0])
+    return Transient(sol.t, sol.y[1], spec.rotation * w, sol.sol, sol.message)
+
+
+def _default_constant(mech: Mechanism, spec: DynamicsSpec) -> float:
+    red = reduced_characteristics(mech, [0.0], spec.rotation, extra_inertia=spec.constant_inertia)
+    return red.inertia_constant
+
+
+def steady_state(mech: Mechanism, spec: DynamicsSpec | None = None, *, constant_inertia: float | None = None,
+                 positions: int | None = None, rtol: float = 1e-10, samples: int = 720,
+                 max_iterations: int = 60) -> LawOfMotion:
+    """The periodic steady state of the equation of motion, by shooting on ``omega(0) = omega(2 pi)``.
+
+    With a constant driving moment every initial speed is periodic when the moment balances the
+    cycle; the steady state is then the one with the declared mean speed.
+    Raises :class:`DynamicsError` when the machine stalls, runs away or no periodic solution is
+    found.
+    """
+    spec = dynamics_of(mech) if spec is None else spec
+    if positions is not None:
+        spec = _replace(spec, positions=positions)
+    constant = _default_constant(mech, spec) if constant_inertia is None else constant_inertia
+    eq = _Equation(mech, spec, None, constant, samples)
+    motor = eq.motor = _motor_of(spec, eq.cycle.driving)
+    limit = _speed_limit(spec, motor)
+    name = f"mechanism '{mech.name}' steady state"
+
+    def one_cycle(energy0):
+        sol = _integrate(eq, energy0, 1, rtol, None, limit)
+        _raise_events(sol, eq, name)
+        return sol
+
+    i0 = float(eq.inertia(0.0))
+    if isinstance(motor, ConstantMotor):
+        w = _speeds(eq.cycle, constant, abs(spec.mean_speed))
+        energy0 = i0 * w[0] ** 2 / 2
+        imbalance = 2 * np.pi * motor.moment + (eq.cycle.energy[-1] - 2 * np.pi * eq.cycle.driving)
+        if abs(imbalance) > 1e-6 * max(eq.scale, 1e-300) * 2 * np.pi:
+            raise DynamicsError(f"{name}: the constant driving moment {motor.moment:.6g} N m does not "
+                                f"balance the cycle's resistance ({eq.cycle.driving:.6g} N m needed): no "
+                                "periodic steady state")
+    else:
+        guess = motor.balance_speed(eq.cycle.driving)
+        if guess is None or not guess > 0:
+            raise DynamicsError(f"{name}: the motor cannot deliver the mean moment {eq.cycle.driving:.6g} N m "
+                                "the cycle needs: the machine would stall")
+        energy0 = i0 * guess**2 / 2
+        for _ in range(3):  # let the start settle towards the attracting cycle
+            energy0 = float(one_cycle(energy0).y[0][-1])
+        f = lambda e0: float(one_cycle(e0).y[0][-1]) - e0  # noqa: E731
+        lo, hi = energy0 * 0.8, energy0 * 1.25
+        for _ in range(max_iterations):
+            if f(lo) * f(hi) <= 0:
+                break
+            lo, hi = lo * 0.8, hi * 1.25
+        else:
+            raise DynamicsError(f"{name}: no periodic solution found near |omega| = {guess:.6g} rad/s")
+        energy0 = brentq(f, lo, hi, xtol=1e-13 * energy0, rtol=1e-13, maxiter=200)
+    sol = one_cycle(energy0)
+    n = spec.positions
+    phi, ends = _cycle(mech, spec, n)
+    psi = np.arange(n + 1) * 2 * np.pi / n
+    red = _with_constant(reduced_characteristics(mech, phi, spec.rotation, ends=ends), constant)
+    w = np.sqrt(2 * sol.sol(psi)[0] / red.inertia)
+    fine = np.linspace(0, 2 * np.pi, 20 * n + 1)
+    w_fine = eq.speed(fine, sol.sol(fine)[0])
+    mean = (np.max(w_fine) + np.min(w_fine)) / 2
+    driving_table = motor(w)
+    cycle_mean = float(np.mean(motor(w_fine)))
+    return LawOfMotion("ode", phi, red, cycle_mean, float(constant), None, _delta(w_fine, mean),
+                       spec.rotation * w, _eps(red, driving_table, red.inertia, w),
+                       {"mean_speed": float(spec.rotation * mean), "period": float(sol.y[1][-1])})
+
+
+# ----------------------------------------------------------------------------------------------
+# the whole pipeline
+# ----------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class DynamicsReport:
+    """The course pipeline's results: the law of motion, reactions under the real motion and the
+    coefficient of dynamics."""
+
+    mechanism: Mechanism
+    law: LawOfMotion
+    balancing_moment: np.ndarray
+    dynamic_coefficient: float
+    comparison: dict
+    notes: tuple[str, ...] = ()
+
+    def columns(self) -> dict[str, np.ndarray]:
+        """Per position: ``phi_deg``, ``reduced_moment_resistance``, ``reduced_moment_driving``,
+        ``reduced_inertia``, ``reduced_inertia_derivative``, ``omega``, ``eps``, ``balancing_moment``."""
+        red = self.law.reduced
+        return {
+            "phi_deg": np.degrees(self.law.phi),
+            "reduced_moment_resistance": red.moment_resistance,
+            "reduced_moment_driving": red.moment_driving,
+            "reduced_inertia": red.inertia,
+            "reduced_inertia_derivative": red.inertia_derivative,
+            "omega": self.law.omega,
+            "eps": self.law.eps,
+            "balancing_moment": self.balancing_moment,
+        }
+
+    def summary(self) -> dict[str, Any]:
+        """The scalar results (JSON keys of ``linkage dynamics``)."""
+        law = self.law
+        return {
+            "method": law.method,
+            "driving_moment": law.driving_moment,
+            "required_constant_inertia": law.required_constant_inertia,
+            "flywheel_inertia": law.flywheel_inertia,
+            "delta_actual": law.delta_actual,
+            "mean_speed_actual": law.mean_speed_actual,
+            "dynamic_coefficient": self.dynamic_coefficient,
+            "constant_inertia_declared": law.reduced.inertia_constant if law.method == "ode" else None,
+            **self.comparison,
+        }
+
+
+def run_dynamics(mech: Mechanism, method: str = "course", *, positions: int | None = None,
+                 delta: float | None = None, mean_speed: float | None = None,
+                 compare: bool = True) -> DynamicsReport:
+    """The whole pipeline: law of motion by ``method``, then kinetostatics under the real motion.
+
+    Parameters
+    ----------
+    method : {"course", "exact", "ode"}
+        Mertsalov's course method, the exact energy method, or the equation of motion with the
+        declared motor (steady state; the flywheel is sized by the exact method for ``delta``).
+    positions, delta, mean_speed
+        Override the declared inputs (mean speed in rad/s, signed).
+    compare : bool
+        Also run the exact method next to the course method and report how far apart they are.
+    """
+    if method not in ("course", "exact", "ode"):
+        raise ValueError(f"method must be 'course', 'exact' or 'ode', got {method!r}")
+    spec = _override(mech, None, delta, mean_speed)
+    if positions is not None:
+        spec = _replace(spec, positions=positions)
+    comparison: dict[str, Any] = {}
+    if method == "course":
+        law = course_method(mech, spec)
+        if compare:
+            exact = exact_method(mech, spec)
+            comparison = {
+                "exact_required_constant_inertia": exact.required_constant_inertia,
+                "exact_flywheel_inertia": exact.flywheel_inertia,
+                "course_vs_exact_inertia": law.required_constant_inertia / exact.required_constant_inertia - 1,
+                "course_delta_exact": _course_delta_exactly(mech, spec, law),
+            }
+    elif method == "exact":
+        law = exact_method(mech, spec)
+    else:
+        constant = None
+        if spec.delta is not None:
+            constant = exact_method(mech, spec).required_constant_inertia
+        law = steady_state(mech, spec, constant_inertia=constant)
+    _, ends = _cycle(mech, spec)
+    motion = analyze(mech, law.phi, order=2, omega=law.omega, eps=law.eps)
+    reactions = solve_reactions(motion, ends=ends)
+    k_dyn = float(np.max(np.abs(reactions.balancing_moment)) / abs(law.driving_moment)) \
+        if law.driving_moment != 0 else float("inf")
+    return DynamicsReport(mech, law, reactions.balancing_moment, k_dyn, comparison, reactions.notes)
+
+
+def _course_delta_exactly(mech: Mechanism, spec: DynamicsSpec, law: LawOfMotion) -> float:
+    """The delta a machine sized by the course method really has (exact energy solution)."""
+    cycle = _fine_cycle(mech, spec, 3600)
+    constant = max(law.required_constant_inertia, cycle.reduced.inertia_constant)
+    wm = abs(spec.mean_speed)
+    return _delta(_speeds(cycle, constant, wm), wm)

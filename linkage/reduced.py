@@ -1,0 +1,136 @@
+"""Reduced characteristics at the input link (METHOD section 6).
+
+With ``s = sign(omega_m)`` and ``psi = s phi`` (the angle in the direction of rotation):
+
+- reduced moment by equality of powers ``M_red = s sum(F . r'_P) + s sum(M_k theta_k')``,
+  split into the driving part (loads declared as driving) and the resisting part ``M_c``
+  (everything else, gravity included);
+- reduced moment of inertia ``I(psi) = I_0 + I''(psi)`` with
+  ``I'' = sum(m_k |r'_Sk|^2 + J_Sk theta_k'^2)`` over the links other than the input link(s), and
+  ``I_0`` the input link's own inertia about its pivot plus the declared constant inertia
+  (rotors through gear ratios, flywheel);
+- ``dI/dpsi = 2 s sum(m_k r'_Sk . r''_Sk + J_Sk theta_k' theta_k'')`` exact from the analogs.
+
+>>> import numpy as np, linkage
+>>> from linkage.reduced import reduced_characteristics
+>>> red = reduced_characteristics(linkage.load("four_bar"), np.linspace(0, 2 * np.pi, 5), rotation=1)
+>>> red.inertia.shape
+(5,)
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from assur.base import point_analogs
+
+from .forces import Loads, evaluate_loads, loads_of
+from .kinematics import analyze
+from .model import Mechanism
+
+__all__ = ["Reduced", "reduced_characteristics", "link_inertia_terms"]
+
+
+@dataclass(frozen=True)
+class Reduced:
+    """Reduced characteristics at N input angles.
+
+    Attributes
+    ----------
+    phi : ndarray (N,)
+        Input angles, rad.
+    rotation : int
+        ``s``: +1 counter-clockwise, -1 clockwise.
+    moment_resistance, moment_driving : ndarray (N,)
+        ``M_c`` and the driving part of the declared loads, reduced to psi, N m.
+    inertia_constant : float
+        ``I_0``, kg m^2.
+    inertia_variable : ndarray (N,)
+        ``I''``, kg m^2.
+    inertia_derivative : ndarray (N,)
+        ``dI/dpsi``, kg m^2 / rad.
+    """
+
+    phi: np.ndarray
+    rotation: int
+    moment_resistance: np.ndarray
+    moment_driving: np.ndarray
+    inertia_constant: float
+    inertia_variable: np.ndarray
+    inertia_derivative: np.ndarray
+
+    @property
+    def inertia(self) -> np.ndarray:
+        """``I(psi) = I_0 + I''(psi)``, kg m^2."""
+        return self.inertia_constant + self.inertia_variable
+
+    @property
+    def moment(self) -> np.ndarray:
+        """Total reduced moment of the declared loads, N m."""
+        return self.moment_resistance + self.moment_driving
+
+
+def link_inertia_terms(motion, links) -> tuple[np.ndarray, np.ndarray]:
+    """``sum(m |r'_S|^2 + J theta'^2)`` and ``sum(m r'_S . r''_S + J theta' theta'')`` over links."""
+    mech = motion.mechanism
+    n = len(motion.phi)
+    inertia, half_derivative = np.zeros(n), np.zeros(n)
+    for k in links:
+        link = mech.links[k]
+        if link.mass == 0 and link.inertia == 0:
+            continue
+        d1, d2 = point_analogs(motion.poses[k], motion.first[k], motion.second[k], link.center_of_mass)
+        t1, t2 = motion.first[k][:, 2], motion.second[k][:, 2]
+        inertia += link.mass * np.einsum("ni,ni->n", d1, d1) + link.inertia * t1**2
+        half_derivative += link.mass * np.einsum("ni,ni->n", d1, d2) + link.inertia * t1 * t2
+    return inertia, half_derivative
+
+
+def reduced_characteristics(
+    mech: Mechanism,
+    phi: ArrayLike,
+    rotation: int,
+    *,
+    loads: Loads | None = None,
+    extra_inertia: float = 0.0,
+    ends: ArrayLike | None = None,
+) -> Reduced:
+    """Reduced moments and moment of inertia at the input angles ``phi``.
+
+    Parameters
+    ----------
+    mech : Mechanism
+    phi : array_like (N,)
+        Input angles, rad.
+    rotation : {1, -1}
+        Sign of the input's angular velocity.
+    loads : Loads, optional
+        Default: the mechanism's declared loads.
+    extra_inertia : float
+        Constant inertia reduced to the input besides the input link's own (rotors, flywheel),
+        kg m^2.
+    ends : array_like of bool, optional
+        Positions that end the cycle (two-valued loads at stroke ends, METHOD section 7).
+    """
+    if rotation not in (1, -1):
+        raise ValueError(f"rotation must be +1 or -1, got {rotation!r}")
+    motion = analyze(mech, phi, order=2, omega=float(rotation), eps=0.0)
+    loads = loads_of(mech) if loads is None else loads
+    n = len(motion.phi)
+    driving, resisting = np.zeros(n), np.zeros(n)
+    for t in evaluate_loads(motion, loads, ends):
+        v, _ = point_analogs(motion.poses[t.link], motion.first[t.link], None, t.local)
+        power = rotation * (np.einsum("ni,ni->n", t.force, v) + t.moment * motion.first[t.link][:, 2])
+        if t.kind == "driving":
+            driving += power
+        else:
+            resisting += power
+    inputs = set(motion.structure.inputs)
+    others = [k for k in mech.moving_links if k not in inputs]
+    variable, half_derivative = link_inertia_terms(motion, others)
+    own, _ = link_inertia_terms(motion, sorted(inputs))
+    return Reduced(motion.phi, rotation, resisting, driving, float(own[0]) + float(extra_inertia),
+                   variable, 2 * rotation * half_derivative)
