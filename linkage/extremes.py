@@ -89,22 +89,24 @@ def _find_extremes(mech: Mechanism, quantity: str, samples: int, xtol: float) ->
     def derivative(phi: float) -> float:
         return analyze(mech, [phi], order=1, outputs=[quantity]).quantity(quantity)[1][0]
 
-    grid = np.linspace(0.0, 2 * np.pi, samples + 1)
+    grid = np.linspace(0.0, 2 * np.pi, samples, endpoint=False)
     motion = analyze(mech, grid, order=1, outputs=[quantity], on_failure="mask")
     d1 = motion.quantity(quantity)[1]
     roots = []
-    for i in range(samples):
-        a, b = d1[i], d1[i + 1]
+    for i in range(samples):  # cyclic: the last interval closes the revolution at 2 pi
+        a, b = d1[i], d1[(i + 1) % samples]
         if not (np.isfinite(a) and np.isfinite(b)):
             continue
         if a == 0.0:
             roots.append(grid[i])
         elif a * b < 0:
-            roots.append(brentq(derivative, grid[i], grid[i + 1], xtol=xtol, rtol=4 * np.finfo(float).eps))
+            roots.append(brentq(derivative, grid[i], grid[i] + 2 * np.pi / samples, xtol=xtol,
+                                rtol=4 * np.finfo(float).eps))
     if not roots:
         raise ValueError(f"'{quantity}' of mechanism '{mech.name}' has no extreme position: its first "
                          "analog does not change sign over a revolution")
-    roots = np.unique(np.mod(roots, 2 * np.pi))
+    roots = np.mod(roots, 2 * np.pi)
+    roots = np.unique(np.where(roots > 2 * np.pi - 1e-12, 0.0, roots))
     values = analyze(mech, roots, order=0, outputs=[quantity]).quantity(quantity)[0]
     i_max, i_min = int(np.argmax(values)), int(np.argmin(values))
     return Extremes(quantity, float(roots[i_max]), float(roots[i_min]), float(values[i_max]),

@@ -84,7 +84,9 @@ def joint_of(pair: Revolute | Prismatic, mech: Mechanism) -> RevoluteJoint | Pri
     if isinstance(pair, Revolute):
         return RevoluteJoint(pair.name, a, b, la.points[pair.point], lb.points[pair.point])
     guide = la.guides[pair.guide]
-    return PrismaticJoint(pair.name, a, b, guide.point, guide.direction, lb.points[pair.point], pair.angle)
+    # the slider's x axis runs along the guide, turned by the pair's angle
+    return PrismaticJoint(pair.name, a, b, guide.point, guide.direction, lb.points[pair.point],
+                          guide.angle + pair.angle)
 
 
 def decompose(mech: Mechanism) -> Structure:
