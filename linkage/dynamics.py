@@ -674,16 +674,34 @@ def run_dynamics(mech: Mechanism, method: str = "course", *, positions: int | No
     elif method == "exact":
         law = exact_method(mech, spec)
     else:
-        constant = None
-        if spec.delta is not None:
-            constant = exact_method(mech, spec).required_constant_inertia
-        law = steady_state(mech, spec, constant_inertia=constant)
+        sized = exact_method(mech, spec) if spec.delta is not None else None
+        law = steady_state(mech, spec, constant_inertia=sized and sized.required_constant_inertia)
+        if sized is not None:
+            law = _replace(law, flywheel_inertia=sized.flywheel_inertia)
+        if spec.initial_speed is not None:
+            comparison = _settling(mech, spec, law)
     _, ends = _cycle(mech, spec)
     motion = analyze(mech, law.phi, order=2, omega=law.omega, eps=law.eps)
     reactions = solve_reactions(motion, ends=ends)
     k_dyn = float(np.max(np.abs(reactions.balancing_moment)) / abs(law.driving_moment)) \
         if law.driving_moment != 0 else float("inf")
     return DynamicsReport(mech, law, reactions.balancing_moment, k_dyn, comparison, reactions.notes)
+
+
+def _settling(mech: Mechanism, spec: DynamicsSpec, law: LawOfMotion) -> dict[str, Any]:
+    """Start-up transient from the declared initial speed: time to come within 1 % of the steady
+    state's mean speed (cycle by cycle)."""
+    transient = simulate(mech, spec, constant_inertia=law.reduced.inertia_constant)
+    target = abs(law.details["mean_speed"])
+    cycle = np.floor(transient.psi / (2 * np.pi)).astype(int)
+    settled = None
+    for k in range(int(cycle.max()) + 1):
+        w = np.abs(transient.omega[cycle == k])
+        if len(w) and abs((w.max() + w.min()) / 2 - target) <= 0.01 * target:
+            settled = float(transient.t[cycle == k][0])
+            break
+    return {"transient_cycles": int(spec.cycles), "transient_time": float(transient.t[-1]),
+            "settling_time": settled}
 
 
 def _course_delta_exactly(mech: Mechanism, spec: DynamicsSpec, law: LawOfMotion) -> float:
