@@ -92,6 +92,9 @@ def _find_extremes(mech: Mechanism, quantity: str, samples: int, xtol: float) ->
     grid = np.linspace(0.0, 2 * np.pi, samples, endpoint=False)
     motion = analyze(mech, grid, order=1, outputs=[quantity], on_failure="mask")
     d1 = motion.quantity(quantity)[1]
+    if not np.nanmax(np.abs(d1)) > 1e-12 * mech.size:
+        raise ValueError(f"'{quantity}' of mechanism '{mech.name}' does not move: it has no extreme "
+                         "positions")
     roots = []
     for i in range(samples):  # cyclic: the last interval closes the revolution at 2 pi
         a, b = d1[i], d1[(i + 1) % samples]

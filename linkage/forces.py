@@ -90,10 +90,11 @@ class StrokeDiagram:
         """
         ext = extreme_positions(mech, self.quantity)
         stroke = ext.value_max - ext.value_min
-        moving = np.sign(first)
+        moving = np.sign(first * rotation)  # direction of the output's motion in time
         at_end = np.abs(first) <= 1e-9 * stroke
         leaving = np.zeros(len(value), bool) if ends is None else np.asarray(ends, bool)
-        entering_dir = np.sign(second * rotation) * np.where(leaving, -1.0, 1.0)
+        # near an extreme q' ~ q'' (phi - phi_e), so the motion just after it goes along sign(q'')
+        entering_dir = np.sign(second) * np.where(leaving, -1.0, 1.0)
         direction = np.where(at_end, entering_dir, moving)
         working = direction == self.working
         start = ext.value_min if self.working > 0 else ext.value_max
@@ -338,6 +339,9 @@ def parse_loads(mech: Mechanism, raw: Mapping[str, Any] | None) -> tuple[Loads, 
             continue
         link = spec.get("link")
         where = f"moments[{i}] (link {link!r})"
+        if set(spec) - {"link", "moment", "diagram"}:
+            problems.append(f"{where}: unknown keys {sorted(set(spec) - {'link', 'moment', 'diagram'})} "
+                            "(known: ['diagram', 'link', 'moment'])")
         if link not in mech.moving_links:
             problems.append(f"{where}: unknown moving link {link!r} (moving links: {mech.moving_links})")
             continue
