@@ -54,7 +54,7 @@ OK, CANNOT_ASSEMBLE, SINGULAR = 0, -1, -2
 
 #: relative closure residual above which a closed-form position counts as not assembled
 CLOSURE_TOL = 1e-9
-#: reciprocal condition number of the scaled group Jacobian below which a position is singular
+#: Hadamard ratio of the scaled group Jacobian below which a position is singular
 SINGULAR_TOL = 1e-9
 
 Poses = Mapping[str, np.ndarray]
@@ -289,8 +289,9 @@ class Group:
         status = np.where(assembled, OK, CANNOT_ASSEMBLE)
         sign = np.zeros(len(status))
         if assembled.any():
-            rcond, det_sign = self._conditioning({k: v[assembled] for k, v in merged.items()})
-            status[np.flatnonzero(assembled)[rcond < SINGULAR_TOL]] = SINGULAR
+            phi_q, _ = self.jacobians({k: v[assembled] for k, v in merged.items()})
+            ratio, det_sign = self._conditioning(phi_q)
+            status[np.flatnonzero(assembled)[ratio < SINGULAR_TOL]] = SINGULAR
             sign[assembled] = det_sign
         for k in new:
             new[k] = np.where(assembled[:, None], new[k], np.nan)
@@ -319,25 +320,38 @@ class Group:
                     phi_k[link][:, 2 * r : 2 * r + 2, :] += block
         return phi_q, phi_k
 
-    def _conditioning(self, poses: Poses):
-        """Reciprocal condition number and det sign of the scale-free group Jacobian."""
-        phi_q, _ = self.jacobians(poses)
+    def _conditioning(self, phi_q: np.ndarray):
+        """Hadamard ratio and det sign of the scale-free group Jacobian.
+
+        Columns of angles are multiplied by the mechanism size and angle rows divided by it, so
+        every entry is dimensionless; the ratio ``|det J| / prod(|row_i|)`` is 1 for orthogonal
+        rows and 0 at a singular (toggle) position. It costs one LU per position (an SVD costs
+        ten times more) and tracks the reciprocal condition number to within a modest factor.
+        """
         rows = np.concatenate([j.row_scale(self.size) for j in self.joints])
         cols = np.tile([1.0, 1.0, 1.0 / self.size], len(self.links))
         scaled = phi_q * rows[None, :, None] * cols[None, None, :]
-        sv = np.linalg.svd(scaled, compute_uv=False)
-        rcond = sv[:, -1] / sv[:, 0]
-        return rcond, np.sign(np.linalg.det(scaled))
+        det = np.linalg.det(scaled)
+        norms = np.prod(np.linalg.norm(scaled, axis=2), axis=1)
+        return np.abs(det) / np.where(norms > 0, norms, 1.0), np.sign(det)
 
     # -- analogs -------------------------------------------------------------------------------
-    def analogs(self, poses: Poses, first: Poses, second: Poses | None = None):
+    def analogs(self, poses: Poses, first: Poses, second: Poses | None = None, valid=None):
         """First (and, if ``second`` of the known links is given, second) analogs of the group.
 
         Solves ``Phi_q q' = -Phi_k q'_k`` and ``Phi_q q'' = -Phi_k q''_k + gamma`` (METHOD 3).
-        Positions where a pose is NaN give NaN.
+        Positions outside ``valid`` (default: where the group is assembled and not singular)
+        give NaN.
         """
         phi_q, phi_k = self.jacobians(poses)
         ok = np.all(np.isfinite(phi_q), axis=(1, 2))
+        if valid is None:
+            ratio = np.zeros(len(ok))
+            if ok.any():
+                ratio[ok] = self._conditioning(phi_q[ok])[0]
+            ok &= ratio >= SINGULAR_TOL
+        else:
+            ok &= np.asarray(valid, bool)
         phi_q[~ok] = np.eye(phi_q.shape[1])
         rhs1 = -sum(np.einsum("nij,nj->ni", phi_k[k], first[k]) for k in self.known_links)
         q1 = np.linalg.solve(phi_q, rhs1[..., None])[..., 0]
@@ -356,7 +370,7 @@ class Group:
         return {link: q[:, 3 * i : 3 * i + 3] for i, link in enumerate(self.links)}
 
     # -- reactions -----------------------------------------------------------------------------
-    def reactions(self, poses: Poses, loads: Poses):
+    def reactions(self, poses: Poses, loads: Poses, valid=None):
         """Joint reactions from the equilibrium of the group's links.
 
         Parameters
@@ -366,6 +380,8 @@ class Group:
         loads : dict
             Generalized applied loads ``(N, 3)`` on each of the group's links: ``Fx, Fy`` (N)
             and the moment about the link's local origin (N m), inertia loads included.
+        valid : array_like of bool, optional
+            Positions to solve (others give NaN), e.g. where the motion is assembled and regular.
 
         Returns
         -------
@@ -376,8 +392,13 @@ class Group:
             Generalized loads the group puts on each known link through its external joints.
         """
         phi_q, phi_k = self.jacobians(poses)
+        ok = np.all(np.isfinite(phi_q), axis=(1, 2))
+        if valid is not None:
+            ok &= np.asarray(valid, bool)
+        phi_q[~ok] = np.eye(phi_q.shape[1])
         q = np.concatenate([loads[link] for link in self.links], axis=1)
         lam = np.linalg.solve(np.transpose(phi_q, (0, 2, 1)), -q[..., None])[..., 0]
+        lam[~ok] = np.nan
         multipliers = {j.name: lam[:, 2 * r : 2 * r + 2] for r, j in enumerate(self.joints)}
         transmitted = {k: np.einsum("nji,nj->ni", phi_k[k], lam) for k in self.known_links}
         return multipliers, transmitted

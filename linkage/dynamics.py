@@ -347,23 +347,33 @@ def _fine_cycle(mech: Mechanism, spec: DynamicsSpec, samples: int) -> _Cycle:
     return _Cycle(psi, red, float(driving), driving * psi + work)
 
 
-def _speeds(cycle: _Cycle, constant: float, mean: float):
-    """|omega|(psi) with the energy level chosen so that (max + min) / 2 = mean."""
+def _speeds(cycle: _Cycle, constant: float, mean: float) -> np.ndarray | None:
+    """|omega|(psi) with the energy level chosen so that (max + min) / 2 = mean.
+
+    ``None`` when no level reaches it: even with omega_min = 0 the mean is above ``mean`` (the
+    machine cannot run that slowly with so little inertia; its delta would exceed 2).
+    """
     inertia = constant + cycle.reduced.inertia_variable
-    low = -np.min(cycle.energy) + 1e-300
+    low = -np.min(cycle.energy)
 
     def mid(t0):
         w = np.sqrt(2 * np.maximum(t0 + cycle.energy, 0.0) / inertia)
         return (np.max(w) + np.min(w)) / 2 - mean
 
-    high = max(1.0, low) + np.max(inertia) * mean**2
+    if mid(low) > 0:
+        return None
+    high = max(abs(low), 1e-300) + np.max(inertia) * mean**2
     while mid(high) < 0:
         high *= 4
     t0 = brentq(mid, low, high, xtol=1e-14 * high, rtol=1e-15)
-    return np.sqrt(2 * (t0 + cycle.energy) / inertia)
+    return np.sqrt(2 * np.maximum(t0 + cycle.energy, 0.0) / inertia)
 
 
-def _delta(w: np.ndarray, mean: float) -> float:
+def _delta(w: np.ndarray | None, mean: float) -> float:
+    """Coefficient of speed fluctuation; 2 where the mean speed is out of reach (the limit of
+    ``(w_max - 0) / ((w_max + 0) / 2)``, so the function stays continuous for root finding)."""
+    if w is None:
+        return 2.0
     return float((np.max(w) - np.min(w)) / mean)
 
 
@@ -394,6 +404,10 @@ def exact_method(mech: Mechanism, spec: DynamicsSpec | None = None, *, positions
                           xtol=1e-13 * high, rtol=1e-14)
         flywheel = constant - base
     w = _speeds(cycle, constant, wm)
+    if w is None:
+        raise DynamicsError(f"mechanism '{mech.name}': with the constant inertia {constant:.6g} kg m^2 "
+                            f"the machine cannot keep the mean speed {wm:.6g} rad/s: give delta to size "
+                            "a flywheel")
     stride = (len(cycle.psi) - 1) // spec.positions
     pick = slice(None, None, stride)
     red = _pick(cycle.reduced, pick, constant)
@@ -527,7 +541,7 @@ def _default_constant(mech: Mechanism, spec: DynamicsSpec) -> float:
 
 
 def steady_state(mech: Mechanism, spec: DynamicsSpec | None = None, *, constant_inertia: float | None = None,
-                 positions: int | None = None, rtol: float = 1e-10, samples: int = 720,
+                 positions: int | None = None, rtol: float = 1e-9, samples: int = 720,
                  max_iterations: int = 60) -> LawOfMotion:
     """The periodic steady state of the equation of motion, by shooting on ``omega(0) = omega(2 pi)``.
 
@@ -553,6 +567,10 @@ def steady_state(mech: Mechanism, spec: DynamicsSpec | None = None, *, constant_
     i0 = float(eq.inertia(0.0))
     if isinstance(motor, ConstantMotor):
         w = _speeds(eq.cycle, constant, abs(spec.mean_speed))
+        if w is None:
+            raise DynamicsError(f"{name}: with the constant inertia {constant:.6g} kg m^2 the machine cannot "
+                                f"keep the mean speed {abs(spec.mean_speed):.6g} rad/s (it would stop "
+                                "within the cycle): add a flywheel")
         energy0 = i0 * w[0] ** 2 / 2
         imbalance = 2 * np.pi * motor.moment + (eq.cycle.energy[-1] - 2 * np.pi * eq.cycle.driving)
         if abs(imbalance) > 1e-6 * max(eq.scale, 1e-300) * 2 * np.pi:
@@ -567,15 +585,21 @@ def steady_state(mech: Mechanism, spec: DynamicsSpec | None = None, *, constant_
         energy0 = i0 * guess**2 / 2
         for _ in range(3):  # let the start settle towards the attracting cycle
             energy0 = float(one_cycle(energy0).y[0][-1])
-        f = lambda e0: float(one_cycle(e0).y[0][-1]) - e0  # noqa: E731
-        lo, hi = energy0 * 0.8, energy0 * 1.25
+        values: dict[float, float] = {}
+
+        def f(e0: float) -> float:
+            if e0 not in values:
+                values[e0] = float(one_cycle(e0).y[0][-1]) - e0
+            return values[e0]
+
+        lo, hi = energy0 * 0.9, energy0 * 1.1
         for _ in range(max_iterations):
             if f(lo) * f(hi) <= 0:
                 break
             lo, hi = lo * 0.8, hi * 1.25
         else:
             raise DynamicsError(f"{name}: no periodic solution found near |omega| = {guess:.6g} rad/s")
-        energy0 = brentq(f, lo, hi, xtol=1e-13 * energy0, rtol=1e-13, maxiter=200)
+        energy0 = brentq(f, lo, hi, xtol=10 * rtol * energy0, rtol=10 * rtol, maxiter=100)
     sol = one_cycle(energy0)
     n = spec.positions
     phi, ends = _cycle(mech, spec, n)
@@ -586,7 +610,7 @@ def steady_state(mech: Mechanism, spec: DynamicsSpec | None = None, *, constant_
     w_fine = eq.speed(fine, sol.sol(fine)[0])
     mean = (np.max(w_fine) + np.min(w_fine)) / 2
     driving_table = motor(w)
-    cycle_mean = float(np.mean(motor(w_fine)))
+    cycle_mean = float(np.mean(motor(w_fine[:-1])))  # one period: psi = 2 pi is psi = 0
     return LawOfMotion("ode", phi, red, cycle_mean, float(constant), None, _delta(w_fine, mean),
                        spec.rotation * w, _eps(red, driving_table, red.inertia, w),
                        {"mean_speed": float(spec.rotation * mean), "period": float(sol.y[1][-1])})

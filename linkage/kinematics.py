@@ -248,7 +248,7 @@ def analyze(
         status = np.where(status == OK, placed.status, status)
         _check_continuity(group, placed, phi)
         if order >= 1:
-            d1, d2 = group.analogs(poses, first, second)
+            d1, d2 = group.analogs(poses, first, second, valid=placed.status == OK)
             first.update(d1)
             if second is not None:
                 second.update(d2)

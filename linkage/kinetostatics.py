@@ -136,7 +136,7 @@ def solve_reactions(
     applied = generalized_loads(motion, terms)
     multipliers: dict[str, np.ndarray] = {}
     for group in reversed(structure.groups):
-        lam, transmitted = group.reactions(motion.poses, applied)
+        lam, transmitted = group.reactions(motion.poses, applied, valid=motion.status == OK)
         multipliers.update(lam)
         for link, load in transmitted.items():
             applied[link] = applied[link] + load

@@ -496,7 +496,7 @@ class MechanismBuilder:
             dict(self._pairs),
             tuple(self._inputs),
             self.frame,
-            tuple(self._assembly),
+            tuple(sorted(self._assembly, key=lambda a: a.point)),
             self._output,
             self.description,
             dict(extra),

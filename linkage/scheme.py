@@ -10,6 +10,7 @@ True
 
 from __future__ import annotations
 
+import copy
 import importlib.resources
 import math
 import re
@@ -82,12 +83,26 @@ def loads(text: str, source: str = "<string>", default_name: str = "mechanism") 
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
-        raise SchemeError(f"{source}: malformed TOML: {exc}") from None
+        raise SchemeError(f"{source}: malformed TOML: {exc}{_context(text, str(exc))}") from None
     try:
         mech = from_dict(data, default_name)
     except SchemeError as exc:
         raise SchemeError([f"{source}: {p}" for p in exc.problems]) from None
     return mech
+
+
+def _context(text: str, message: str) -> str:
+    """The offending line (and the table it is in) of a TOML error message ``(at line N, ...)``."""
+    found = re.search(r"at line (\d+)", message)
+    if not found:
+        return ""
+    lines = text.splitlines()
+    number = int(found.group(1))
+    if not 1 <= number <= len(lines):
+        return ""
+    tables = [ln.strip() for ln in lines[:number] if re.match(r"\s*\[", ln)]
+    where = f" in {tables[-1].split('#')[0].strip()}" if tables else ""
+    return f"; line {number}{where}: {lines[number - 1].strip()!r}"
 
 
 def from_dict(data: Mapping[str, Any], default_name: str = "mechanism") -> Mechanism:
@@ -253,7 +268,7 @@ def to_dict(mech: Mechanism) -> dict[str, Any]:
                 data["assembly"][rule.point] = {"towards": rule.angle, "from": rule.refs[0]}
             else:
                 data["assembly"][rule.point] = {rule.rule: list(rule.refs)}
-    data.update(mech.extra)
+    data.update(copy.deepcopy(dict(mech.extra)))
     return data
 
 

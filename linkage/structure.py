@@ -105,7 +105,8 @@ def decompose(mech: Mechanism) -> Structure:
     if w != len(mech.inputs):
         raise StructureError(
             f"mechanism '{mech.name}': mobility W = 3·{len(mech.moving_links)} - 2·{len(mech.pairs)}"
-            f" = {w}, but {len(mech.inputs)} input link(s) are declared {list(mech.inputs)}"
+            f" = {w}, but {len(mech.inputs)} input link(s) are declared {list(mech.inputs)} "
+            f"(moving links {mech.moving_links}; pairs {sorted(mech.pairs)})"
         )
     joints = {name: joint_of(pair, mech) for name, pair in mech.pairs.items()}
     input_joints = {}
