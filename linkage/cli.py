@@ -2,6 +2,10 @@
 
     linkage schemes                                   list the shipped schemes
     linkage analyze SCHEME [--positions N] [--start extreme|max|min|DEG] [--format table|csv|json]
+    linkage forces SCHEME [--positions N] [--omega RAD_S | --rpm RPM] [--eps RAD_S2]
+                          [--start ...] [--format table|csv|json]
+    linkage dynamics SCHEME [--positions N] [--delta D] [--rpm R | --omega W]
+                            [--method course|exact|ode] [--format table|json]
 
 Every subcommand is one ``_add_<name>(subparsers)`` function that registers its parser and sets
 ``handler`` to a function ``(args) -> int``; add a new command by writing such a pair and listing
@@ -35,6 +39,13 @@ PROG = "linkage"
 
 #: exit status of errors in the user's input (same as argparse's usage errors)
 EXIT_INPUT = 2
+
+
+def _rotation(mech) -> int:
+    """Order of table positions: the sign of the scheme's declared mean speed, else +1."""
+    from .dynamics import dynamics_of
+
+    return dynamics_of(mech).rotation if mech.extra.get("dynamics") is not None else 1
 
 
 # ----------------------------------------------------------------------------------------------
@@ -158,42 +169,57 @@ def _add_analyze(sub) -> None:
     p.set_defaults(handler=_cmd_analyze)
 
 
-def _table_positions(mech, n: int, start: str | float) -> tuple[np.ndarray, str | float]:
+def _table_positions(mech, n: int, start: str | float, direction: int) -> tuple[np.ndarray, str | float]:
     """Input angles of the table (rad) and the start actually used."""
     if isinstance(start, str) and mech.output is None:
         _note("note", f"scheme '{mech.name}' declares no output, so it has no extreme position: "
                       "the table starts at phi = 0 deg (use --start DEG to choose)")
         start = 0.0
-    direction = 1  # sign of omega; schemes do not declare the sense of rotation yet
-    return table_angles(mech, n, start, direction), start
+    try:
+        return table_angles(mech, n, start, direction), start
+    except ValueError as exc:
+        if isinstance(start, str) and not isinstance(exc, LinkageError):
+            raise ValueError(f"{exc} (choose position 1 with --start DEG)") from None
+        raise
 
 
 def _cmd_analyze(args: argparse.Namespace) -> int:
     mech = load(args.scheme)
-    phi, start = _table_positions(mech, args.positions, args.start)
+    direction = _rotation(mech)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
+        phi, start = _table_positions(mech, args.positions, args.start, direction)
         motion = analyze(mech, phi, order=2, on_failure="mask")
         columns = motion.columns()
+    if not isinstance(start, str):
+        # label the rows with the angles as given (30, 60, ...), not their degrees(radians(...))
+        # round trip (29.999999999999996, ...); the difference is at the last digit
+        columns["phi_deg"] = start + direction * np.arange(len(phi)) * 360.0 / args.positions
     failed = _report_failures(motion)
     for w in caught:
         if issubclass(w.category, RuntimeWarning) and failed:
             continue  # numerical noise at the masked positions, reported above
         _note("warning", str(w.message))
+    phi0_deg = float(columns["phi_deg"][0])
     meta = {
         "scheme": mech.name,
         "description": mech.description,
         "formula": structure_of(mech).formula,
         "positions": args.positions,
         "start": start,
-        "phi0_deg": float(np.degrees(phi[0])),
-        "direction": 1,
+        "phi0_deg": phi0_deg,
+        "direction": direction,
         "units": "SI (m, rad); phi_deg in degrees; ' and '' are d/dphi and d2/dphi2",
         "failed": failed,
     }
     if args.format == "table":
         meta = {k: meta[k] for k in ("scheme", "formula")}
-        meta["start"] = f"phi0 = {np.degrees(phi[0]):.7g} deg ({start}), {args.positions} steps"
+        where = ""
+        if isinstance(start, str):
+            which = mech.output.start if start == "extreme" else start
+            where = f" ({which} of {mech.output.quantity})"
+        shown = round(phi0_deg, 10) + 0.0  # no round-off noise such as 5e-14 deg for 0
+        meta["start"] = f"phi0 = {shown:.10g} deg{where}, {args.positions} steps per revolution"
     _out(format_columns(columns, args.format, meta=meta))
     return 0
 
@@ -218,16 +244,137 @@ def _report_failures(motion) -> list[dict]:
 
 
 # ----------------------------------------------------------------------------------------------
+# linkage forces
+# ----------------------------------------------------------------------------------------------
+
+
+def _add_speed_arguments(p: argparse.ArgumentParser, what: str) -> None:
+    speed = p.add_mutually_exclusive_group()
+    speed.add_argument("--omega", metavar="RAD_S", type=float,
+                       help=f"{what}, rad/s, signed (negative: clockwise)")
+    speed.add_argument("--rpm", metavar="RPM", type=float, help=f"{what}, rpm, signed")
+
+
+def _speed(args) -> float | None:
+    if args.rpm is not None:
+        return args.rpm * 2 * math.pi / 60
+    return args.omega
+
+
+def _add_forces(sub) -> None:
+    p = sub.add_parser(
+        "forces", help="kinetostatics: pair reactions and the balancing moment",
+        description="Reactions in every pair and the balancing moment on the input link at N "
+                    "equal steps of phi, from the scheme's loads (gravity, external forces and "
+                    "diagrams) and the inertia loads of the given motion (METHOD section 5). "
+                    "Columns: phi_deg, balancing_moment (N m), and for each pair K: K.R (N) and "
+                    "K.angle_deg, the force R[a, b] that link b exerts on link a for the pair's "
+                    "links = [a, b]. JSON rows also carry K.Rx, K.Ry and, for prismatic pairs, "
+                    "K.M (N m, about the slider's point).")
+    _add_scheme_argument(p)
+    _add_positions_arguments(p)
+    _add_speed_arguments(p, "input angular velocity (default: the scheme's mean speed, else "
+                            "none: a static analysis)")
+    p.add_argument("--eps", metavar="RAD_S2", type=float, default=0.0,
+                   help="input angular acceleration, rad/s^2 (default 0)")
+    _add_format_argument(p)
+    p.set_defaults(handler=_cmd_forces)
+
+
+def _cmd_forces(args: argparse.Namespace) -> int:
+    from .kinetostatics import solve_reactions, virtual_power_residual
+
+    mech = load(args.scheme)
+    omega = _speed(args)
+    if omega is None and mech.extra.get("dynamics") is not None:
+        from .dynamics import dynamics_of
+
+        omega = dynamics_of(mech).mean_speed
+    direction = _rotation(mech) if not omega else int(np.sign(omega))
+    phi, start = _table_positions(mech, args.positions, args.start, direction)
+    motion = analyze(mech, phi, order=2, omega=omega, eps=args.eps, on_failure="mask")
+    failed = _report_failures(motion)
+    ends = np.zeros(len(phi), bool)
+    ends[-1] = True
+    reactions = solve_reactions(motion, ends=ends)
+    for note in reactions.notes:
+        _note("note", note)
+    residual = virtual_power_residual(reactions)
+    columns = reactions.columns(full=args.format == "json")
+    meta = {"scheme": mech.name, "formula": structure_of(mech).formula,
+            "omega": omega, "eps": args.eps, "positions": args.positions, "start": start,
+            "convention": "K.R = |R[a,b]|, the force link b exerts on link a (pair links = [a, b])",
+            "virtual_power_residual_max": float(np.nanmax(residual)) if np.isfinite(residual).any() else None,
+            "failed": failed, "notes": list(reactions.notes)}
+    if args.format == "table":
+        meta = {k: meta[k] for k in ("scheme", "omega", "eps", "virtual_power_residual_max")}
+    _out(format_columns(columns, args.format, meta=meta))
+    return 0
+
+
+# ----------------------------------------------------------------------------------------------
+# linkage dynamics
+# ----------------------------------------------------------------------------------------------
+
+
+def _add_dynamics(sub) -> None:
+    p = sub.add_parser(
+        "dynamics", help="machine dynamics: flywheel, law of motion, reactions under real motion",
+        description="The course pipeline (METHOD section 6): reduced moments and inertia, the "
+                    "constant driving moment, the flywheel for a coefficient of speed fluctuation "
+                    "delta, the crank's omega(phi) and eps(phi), then the balancing moment under "
+                    "that motion and the coefficient of dynamics max|M_b| / |M_d|. Methods: "
+                    "'course' (Mertsalov, table positions), 'exact' (energy equation on a fine "
+                    "grid, exact flywheel), 'ode' (equation of motion with the scheme's motor, "
+                    "steady state by shooting). Inputs come from the scheme's [dynamics] section; "
+                    "the options override them.")
+    _add_scheme_argument(p)
+    p.add_argument("--positions", "-n", metavar="N", type=_positions, default=None,
+                   help="N equal steps per revolution (default: the scheme's, else 12)")
+    p.add_argument("--delta", metavar="D", type=float, default=None,
+                   help="coefficient of speed fluctuation (default: the scheme's)")
+    _add_speed_arguments(p, "mean speed of the input link (default: the scheme's)")
+    p.add_argument("--method", choices=("course", "exact", "ode"), default="course",
+                   help="course (default), exact or ode")
+    p.add_argument("--format", "-f", choices=("table", "json"), default="table",
+                   help="aligned text (default) or JSON")
+    p.set_defaults(handler=_cmd_dynamics)
+
+
+def _cmd_dynamics(args: argparse.Namespace) -> int:
+    from .dynamics import run_dynamics
+
+    mech = load(args.scheme)
+    if args.method == "ode":
+        _note("note", "sizing the flywheel (exact method), then shooting for the motor-driven "
+                      "steady state and integrating the start-up transient; this takes a few seconds")
+    report = run_dynamics(mech, args.method, positions=args.positions, delta=args.delta,
+                          mean_speed=_speed(args))
+    for note in report.notes:
+        _note("note", note)
+    summary = {"scheme": mech.name, **report.summary()}
+    if args.format == "json":
+        _out(format_columns(report.columns(), "json", meta=summary))
+    else:
+        shown = {k: (f"{v:.6g}" if isinstance(v, float) else ("none needed" if v is None and
+                 k == "flywheel_inertia" else v)) for k, v in summary.items() if v is not None
+                 or k == "flywheel_inertia"}
+        _out(format_columns(report.columns(), "table", meta=shown))
+    return 0
+
+
+# ----------------------------------------------------------------------------------------------
 # the parser and main
 # ----------------------------------------------------------------------------------------------
 
 #: functions that register one subcommand each, in the order ``--help`` lists them
-COMMANDS: list[Callable] = [_add_schemes, _add_analyze]
+COMMANDS: list[Callable] = [_add_schemes, _add_analyze, _add_forces, _add_dynamics]
 
 
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
-        prog=PROG, description="Planar linkage analysis: Assur groups, exact kinematics.")
+        prog=PROG, description="Planar linkage analysis: Assur groups, exact kinematics, "
+                               "kinetostatics and machine dynamics.")
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     for register in COMMANDS:

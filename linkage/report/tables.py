@@ -38,7 +38,7 @@ FORMATS = ("table", "csv", "json")
 #: significant digits of numbers in the human-readable table
 TABLE_DIGITS = 7
 
-#: in the human-readable table, values smaller than this fraction of their column's largest
+#: in the human-readable table, values smaller than this fraction of the table's largest
 #: magnitude are round-off noise around zero and are shown as 0 (CSV and JSON keep them)
 TABLE_ZERO = 1e-12
 
@@ -133,17 +133,23 @@ def _json(cols: dict[str, np.ndarray], meta: Mapping[str, Any] | None) -> str:
     return json.dumps(doc, ensure_ascii=False, allow_nan=False)
 
 
-def _human(column: np.ndarray) -> list[str]:
+def _human(column: np.ndarray, scale: float) -> list[str]:
     if column.dtype.kind != "f":
         return [str(x) for x in _values(column)]
-    finite = column[np.isfinite(column)]
-    scale = float(np.max(np.abs(finite))) if finite.size else 0.0
     cleaned = np.where(np.abs(column) <= TABLE_ZERO * scale, 0.0, column)
     return [f"{x:.{TABLE_DIGITS}g}" for x in (cleaned + 0.0).tolist()]  # + 0.0: no "-0"
 
 
+def _scale(cols: dict[str, np.ndarray]) -> float:
+    """Largest finite magnitude of the table's float columns."""
+    finite = [np.abs(c[np.isfinite(c)]) for c in cols.values() if c.dtype.kind == "f"]
+    finite = [f for f in finite if f.size]
+    return float(max(f.max() for f in finite)) if finite else 0.0
+
+
 def _table(cols: dict[str, np.ndarray], meta: Mapping[str, Any] | None) -> str:
-    cells = {name: _human(c) for name, c in cols.items()}
+    scale = _scale(cols)
+    cells = {name: _human(c, scale) for name, c in cols.items()}
     widths = {name: max([len(name)] + [len(s) for s in cells[name]]) for name in cols}
     lines = [f"# {k}: {v}" for k, v in (meta or {}).items()]
     lines.append("  ".join(name.rjust(widths[name]) for name in cols))
