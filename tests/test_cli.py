@@ -142,9 +142,13 @@ def test_analyze_formats_agree_and_have_the_contract_columns(capsys, scheme):
     # 12 equal steps, rows 1..13, row 13 = row 1 + 360 deg
     phi = cols["phi_deg"]
     assert len(phi) == 13
-    np.testing.assert_allclose(np.diff(phi), 30.0, rtol=0, atol=1e-9)
-    # the input link's angle is phi itself (METHOD section 1)
-    np.testing.assert_allclose(cols[f"{mech.inputs[0]}.theta"], np.radians(phi), rtol=0, atol=1e-12)
+    # positions follow the declared sense of rotation (the [dynamics] mean speed), else CCW
+    dyn = mech.extra.get("dynamics") or {}
+    sense = -1.0 if dyn.get("mean_speed", dyn.get("mean_rpm", 1)) < 0 else 1.0
+    np.testing.assert_allclose(np.diff(phi), sense * 30.0, rtol=0, atol=1e-9)
+    # the input link's angle is phi itself (METHOD section 1), up to whole turns
+    turns = np.angle(np.exp(1j * (cols[f"{mech.inputs[0]}.theta"] - np.radians(phi))))
+    np.testing.assert_allclose(turns, 0.0, rtol=0, atol=1e-12)
     # position 13 is position 1 again
     for name, values in cols.items():
         if name == "phi_deg":
