@@ -31,6 +31,7 @@ reactions). Status codes per position: ``OK = 0``, ``CANNOT_ASSEMBLE = -1``, ``S
 
 from __future__ import annotations
 
+from abc import ABC, abstractmethod
 from dataclasses import dataclass
 from typing import ClassVar, Mapping, Sequence
 
@@ -240,7 +241,7 @@ class GroupPosition:
     jacobian_sign: np.ndarray  # sign of det of the group Jacobian (0 where not assembled)
 
 
-class Group:
+class Group(ABC):
     """Base class of Assur group solvers (see the module docstring for the plug-in contract).
 
     Attributes
@@ -270,8 +271,9 @@ class Group:
         return cls._bind(tuple(links), tuple(joints), set(known), size)
 
     @classmethod
-    def _bind(cls, links, joints, known, size):  # pragma: no cover - abstract hook
-        raise NotImplementedError
+    @abstractmethod
+    def _bind(cls, links, joints, known, size):
+        """Hook: an instance when this kind solves the group, else ``None``."""
 
     def __repr__(self) -> str:
         return f"{self.group_class}-{self.kind}({','.join(self.links)})"
@@ -297,8 +299,9 @@ class Group:
             new[k] = np.where(assembled[:, None], new[k], np.nan)
         return GroupPosition(new, status, sign)
 
-    def _position(self, poses: Poses, branch: int):  # pragma: no cover - abstract hook
-        raise NotImplementedError
+    @abstractmethod
+    def _position(self, poses: Poses, branch: int):
+        """Hook: ``(new_poses, assembled)`` in closed form (see the module docstring)."""
 
     # -- the constraint system -----------------------------------------------------------------
     def residual(self, poses: Poses) -> np.ndarray:

@@ -30,6 +30,7 @@ from . import __version__
 from .errors import LinkageError, SchemeError
 from .extremes import table_angles
 from .kinematics import analyze, structure_of
+from .motors import RPM
 from .report import FORMATS, format_columns
 from .scheme import load, shipped_schemes
 
@@ -257,7 +258,7 @@ def _add_speed_arguments(p: argparse.ArgumentParser, what: str) -> None:
 
 def _speed(args) -> float | None:
     if args.rpm is not None:
-        return args.rpm * 2 * math.pi / 60
+        return args.rpm * RPM
     return args.omega
 
 
