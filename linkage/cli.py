@@ -291,6 +291,9 @@ def _cmd_forces(args: argparse.Namespace) -> int:
         from .dynamics import dynamics_of
 
         omega = dynamics_of(mech).mean_speed
+    if omega is None and args.eps != 0:
+        _note("note", "no speed given: omega = 0 with the given eps")
+        omega = 0.0
     direction = _rotation(mech) if not omega else int(np.sign(omega))
     phi, start = _table_positions(mech, args.positions, args.start, direction)
     motion = analyze(mech, phi, order=2, omega=omega, eps=args.eps, on_failure="mask")

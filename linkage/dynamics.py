@@ -206,7 +206,8 @@ class LawOfMotion:
     phi : ndarray (n+1,)
         Table input angles, rad (``phi_i = phi0 + s (i-1) 2 pi / n``).
     reduced : Reduced
-        Reduced characteristics at the table positions (with the constant inertia in use).
+        Reduced characteristics of the machine as declared at the table positions
+        (``reduced.inertia`` is ``I_0 + I''``, without a flywheel the method adds).
     driving_moment : float
         Constant (or cycle-mean, for "ode") driving moment, N m.
     required_constant_inertia : float
@@ -216,6 +217,8 @@ class LawOfMotion:
         Flywheel to add, kg m^2; None when none is needed.
     delta_actual : float
         Coefficient of speed fluctuation of the resulting motion.
+    constant_inertia : float
+        Constant inertia at the crank in the resulting motion: ``I_0`` plus the flywheel, kg m^2.
     omega, eps : ndarray (n+1,)
         Angular velocity (rad/s, signed) and acceleration (rad/s^2) of the crank.
     details : dict
@@ -229,9 +232,15 @@ class LawOfMotion:
     required_constant_inertia: float
     flywheel_inertia: float | None
     delta_actual: float
+    constant_inertia: float
     omega: np.ndarray
     eps: np.ndarray
     details: dict = field(default_factory=dict)
+
+    @property
+    def inertia(self) -> np.ndarray:
+        """Reduced moment of inertia in the resulting motion, flywheel included, kg m^2."""
+        return self.constant_inertia + self.reduced.inertia_variable
 
     @property
     def mean_speed_actual(self) -> float:
@@ -285,17 +294,11 @@ def course_method(mech: Mechanism, spec: DynamicsSpec | None = None, *, position
     energy_total = mean_energy + energy_flywheel - (np.max(energy_flywheel) + np.min(energy_flywheel)) / 2
     w = np.sqrt(2 * energy_total / constant)
     inertia = constant + red.inertia_variable
-    reduced = _with_constant(red, constant)
-    return LawOfMotion("course", phi, reduced, float(driving), float(required),
-                       float(flywheel) if flywheel > 0 else None, float(delta_actual),
+    return LawOfMotion("course", phi, red, float(driving), float(required),
+                       float(flywheel) if flywheel > 0 else None, float(delta_actual), float(constant),
                        spec.rotation * w, _eps(red, driving, inertia, w),
                        {"work_resistance": work, "energy_change": energy, "energy_links": energy_links,
                         "energy_flywheel": energy_flywheel, "energy_swing": swing})
-
-
-def _with_constant(red: Reduced, constant: float) -> Reduced:
-    return Reduced(red.phi, red.rotation, red.moment_resistance, red.moment_driving, float(constant),
-                   red.inertia_variable, red.inertia_derivative)
 
 
 def _override(mech, spec, delta, mean_speed) -> DynamicsSpec:
@@ -393,16 +396,18 @@ def exact_method(mech: Mechanism, spec: DynamicsSpec | None = None, *, positions
     cycle = _fine_cycle(mech, spec, samples)
     wm = abs(spec.mean_speed)
     base = cycle.reduced.inertia_constant
-    delta_base = _delta(_speeds(cycle, base, wm), wm)
-    if spec.delta is None or delta_base <= spec.delta:
-        constant, flywheel = base, None
-    else:
+    required = base
+    if spec.delta is not None:
+        # the constant inertia that gives exactly delta, whether or not I_0 already exceeds it
+        fluctuation = lambda c: _delta(_speeds(cycle, c, wm), wm) - spec.delta  # noqa: E731
+        low = 1e-12 * (base + float(np.max(cycle.reduced.inertia_variable)) + 1e-300)
         high = base + 1.0
-        while _delta(_speeds(cycle, high, wm), wm) > spec.delta:
+        while fluctuation(high) > 0:
             high = 2 * high + 1.0
-        constant = brentq(lambda c: _delta(_speeds(cycle, c, wm), wm) - spec.delta, base, high,
-                          xtol=1e-13 * high, rtol=1e-14)
-        flywheel = constant - base
+        required = low if fluctuation(low) <= 0 else brentq(fluctuation, low, high, xtol=1e-13 * high,
+                                                             rtol=1e-14)
+    flywheel = required - base if required > base else None
+    constant = max(required, base)
     w = _speeds(cycle, constant, wm)
     if w is None:
         raise DynamicsError(f"mechanism '{mech.name}': with the constant inertia {constant:.6g} kg m^2 "
@@ -410,17 +415,18 @@ def exact_method(mech: Mechanism, spec: DynamicsSpec | None = None, *, positions
                             "a flywheel")
     stride = (len(cycle.psi) - 1) // spec.positions
     pick = slice(None, None, stride)
-    red = _pick(cycle.reduced, pick, constant)
+    red = _pick(cycle.reduced, pick)
     w_table = w[pick]
-    return LawOfMotion("exact", red.phi, red, cycle.driving, float(constant),
-                       None if flywheel is None else float(flywheel), _delta(w, wm),
-                       spec.rotation * w_table, _eps(red, cycle.driving, red.inertia, w_table),
+    return LawOfMotion("exact", red.phi, red, cycle.driving, float(required),
+                       None if flywheel is None else float(flywheel), _delta(w, wm), float(constant),
+                       spec.rotation * w_table,
+                       _eps(red, cycle.driving, constant + red.inertia_variable, w_table),
                        {"samples": len(cycle.psi) - 1})
 
 
-def _pick(red: Reduced, index, constant: float) -> Reduced:
+def _pick(red: Reduced, index) -> Reduced:
     return Reduced(red.phi[index], red.rotation, red.moment_resistance[index], red.moment_driving[index],
-                   float(constant), red.inertia_variable[index], red.inertia_derivative[index])
+                   red.inertia_constant, red.inertia_variable[index], red.inertia_derivative[index])
 
 
 # ----------------------------------------------------------------------------------------------
@@ -604,15 +610,18 @@ def steady_state(mech: Mechanism, spec: DynamicsSpec | None = None, *, constant_
     n = spec.positions
     phi, ends = _cycle(mech, spec, n)
     psi = np.arange(n + 1) * 2 * np.pi / n
-    red = _with_constant(reduced_characteristics(mech, phi, spec.rotation, ends=ends), constant)
-    w = np.sqrt(2 * sol.sol(psi)[0] / red.inertia)
+    red = reduced_characteristics(mech, phi, spec.rotation, extra_inertia=spec.constant_inertia, ends=ends)
+    inertia = constant + red.inertia_variable
+    w = np.sqrt(2 * sol.sol(psi)[0] / inertia)
     fine = np.linspace(0, 2 * np.pi, 20 * n + 1)
     w_fine = eq.speed(fine, sol.sol(fine)[0])
     mean = (np.max(w_fine) + np.min(w_fine)) / 2
     driving_table = motor(w)
     cycle_mean = float(np.mean(motor(w_fine[:-1])))  # one period: psi = 2 pi is psi = 0
-    return LawOfMotion("ode", phi, red, cycle_mean, float(constant), None, _delta(w_fine, mean),
-                       spec.rotation * w, _eps(red, driving_table, red.inertia, w),
+    flywheel = constant - red.inertia_constant
+    return LawOfMotion("ode", phi, red, cycle_mean, float(constant), flywheel if flywheel > 0 else None,
+                       _delta(w_fine, mean), float(constant),
+                       spec.rotation * w, _eps(red, driving_table, inertia, w),
                        {"mean_speed": float(spec.rotation * mean), "period": float(sol.y[1][-1])})
 
 
@@ -659,7 +668,7 @@ class DynamicsReport:
             "delta_actual": law.delta_actual,
             "mean_speed_actual": law.mean_speed_actual,
             "dynamic_coefficient": self.dynamic_coefficient,
-            "constant_inertia_declared": law.reduced.inertia_constant if law.method == "ode" else None,
+            "constant_inertia": law.constant_inertia,
             **self.comparison,
         }
 
@@ -699,9 +708,7 @@ def run_dynamics(mech: Mechanism, method: str = "course", *, positions: int | No
         law = exact_method(mech, spec)
     else:
         sized = exact_method(mech, spec) if spec.delta is not None else None
-        law = steady_state(mech, spec, constant_inertia=sized and sized.required_constant_inertia)
-        if sized is not None:
-            law = _replace(law, flywheel_inertia=sized.flywheel_inertia)
+        law = steady_state(mech, spec, constant_inertia=sized and sized.constant_inertia)
         if spec.initial_speed is not None:
             comparison = _settling(mech, spec, law)
     _, ends = _cycle(mech, spec)
@@ -715,7 +722,7 @@ def run_dynamics(mech: Mechanism, method: str = "course", *, positions: int | No
 def _settling(mech: Mechanism, spec: DynamicsSpec, law: LawOfMotion) -> dict[str, Any]:
     """Start-up transient from the declared initial speed: time to come within 1 % of the steady
     state's mean speed (cycle by cycle)."""
-    transient = simulate(mech, spec, constant_inertia=law.reduced.inertia_constant)
+    transient = simulate(mech, spec, constant_inertia=law.constant_inertia)
     target = abs(law.details["mean_speed"])
     cycle = np.floor(transient.psi / (2 * np.pi)).astype(int)
     settled = None

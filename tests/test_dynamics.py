@@ -272,8 +272,9 @@ def test_course_method_recomputed(course):
     eps = s * (md + moment - 0.5 * di_dpsi * w**2) / inertia
     assert rel(course.eps, eps) < 1e-7
 
-    # the reported constant inertia in use is I' (a flywheel is needed)
-    assert course.reduced.inertia_constant == pytest.approx(required, rel=1e-12)
+    # the constant inertia in use is I' (a flywheel is needed); the declared machine keeps I_0
+    assert course.constant_inertia == pytest.approx(required, rel=1e-12)
+    assert course.reduced.inertia_constant == pytest.approx(I0_DECLARED, rel=1e-12)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -312,10 +313,11 @@ def test_exact_method_satisfies_its_definition_on_its_grid(press):
     step = 2 * np.pi / n
     md = -trapezoid_cumulative(red.moment, step)[-1] / (2 * np.pi)
     assert law.driving_moment == pytest.approx(md, rel=1e-12)
-    energy = red.inertia * w**2 / 2
+    energy = (law.constant_inertia + red.inertia_variable) * w**2 / 2
     change = trapezoid_cumulative(md + red.moment, step)
     assert rel(energy - energy[0], change) < 1e-9
-    assert red.inertia_constant == pytest.approx(law.required_constant_inertia, rel=1e-15)
+    assert law.constant_inertia == pytest.approx(law.required_constant_inertia, rel=1e-15)
+    assert red.inertia_constant == pytest.approx(I0_DECLARED, rel=1e-15)
     assert law.flywheel_inertia == pytest.approx(law.required_constant_inertia - I0_DECLARED, rel=1e-12)
 
 
@@ -339,7 +341,7 @@ def test_exact_method_cycle_energy_balance(press, press_md):
     seg = [simpson(law.driving_moment + red.moment[i * k:(i + 1) * k + 1], psi[i * k:(i + 1) * k + 1])
            for i in range(N_POS)]
     change = np.concatenate([[0.0], np.cumsum(seg)])
-    energy = law.reduced.inertia * law.omega**2 / 2
+    energy = law.inertia * law.omega**2 / 2
     assert np.max(np.abs(energy - energy[0] - change)) / np.ptp(change) < 1e-4
 
 
