@@ -126,20 +126,24 @@ class Motion:
         return joint.slide(self.poses, self.first, self.second)
 
     def velocity(self, name: str) -> np.ndarray:
-        """Real velocity of a quantity (``q' omega``), or of a point ``(N, 2)`` given its name."""
+        """Real velocity ``q' omega``: of a point ``(N, 2)`` given its name, or of a quantity
+        (``"B.x"``, ``"3.theta"``, ``"K.s"``) ``(N,)``."""
         self._need_speed()
-        d1 = self.point_analogs(name)[0] if "." not in name else self.quantity(name)[1]
+        d1 = self._analogs(name)[0]
         return d1 * (self.omega[:, None] if d1.ndim == 2 else self.omega)
 
     def acceleration(self, name: str) -> np.ndarray:
-        """Real acceleration ``q'' omega^2 + q' eps`` of a quantity or of a point ``(N, 2)``."""
+        """Real acceleration ``q'' omega^2 + q' eps`` of a point ``(N, 2)`` or a quantity ``(N,)``."""
         self._need_speed()
         self._need(2)
-        if "." in name:
-            _, d1, d2 = self.quantity(name)
-            return d2 * self.omega**2 + d1 * self.eps
-        d1, d2 = self.point_analogs(name)
-        return d2 * self.omega[:, None] ** 2 + d1 * self.eps[:, None]
+        d1, d2 = self._analogs(name)
+        w, e = (self.omega[:, None], self.eps[:, None]) if d1.ndim == 2 else (self.omega, self.eps)
+        return d2 * w**2 + d1 * e
+
+    def _analogs(self, name: str):
+        if name in self.mechanism.point_names:
+            return self.point_analogs(name)
+        return self.quantity(name)[1:]
 
     def _need_speed(self) -> None:
         if self.omega is None:
