@@ -227,6 +227,13 @@ class PrismaticJoint:
 Joint = RevoluteJoint | PrismaticJoint
 
 
+def _local_points(joint: Joint, link: str):
+    """The local point(s) by which ``joint`` acts on ``link``."""
+    if isinstance(joint, RevoluteJoint):
+        return joint.local(link)[0]
+    return joint.g if link == joint.a else joint.p
+
+
 # ----------------------------------------------------------------------------------------------
 # the group protocol
 # ----------------------------------------------------------------------------------------------
@@ -263,6 +270,9 @@ class Group(ABC):
         self.joints = tuple(joints)
         self.size = float(size)
         self.known_links = tuple(sorted(({j.a for j in joints} | {j.b for j in joints}) - set(links)))
+        # each link's joint points (local), whose centroid the singularity measure rotates about
+        self._centroids = {link: np.mean([_local_points(j, link) for j in self.joints
+                                          if link in (j.a, j.b)], axis=0) for link in self.links}
 
     # -- binding -------------------------------------------------------------------------------
     @classmethod
@@ -291,8 +301,8 @@ class Group(ABC):
         status = np.where(assembled, OK, CANNOT_ASSEMBLE)
         sign = np.zeros(len(status))
         if assembled.any():
-            phi_q, _ = self.jacobians({k: v[assembled] for k, v in merged.items()})
-            ratio, det_sign = self._conditioning(phi_q)
+            regular = {k: v[assembled] for k, v in merged.items()}
+            ratio, det_sign = self._conditioning(self.jacobians(regular)[0], regular)
             status[np.flatnonzero(assembled)[ratio < SINGULAR_TOL]] = SINGULAR
             sign[assembled] = det_sign
         for k in new:
@@ -323,17 +333,24 @@ class Group(ABC):
                     phi_k[link][:, 2 * r : 2 * r + 2, :] += block
         return phi_q, phi_k
 
-    def _conditioning(self, phi_q: np.ndarray):
+    def _conditioning(self, phi_q: np.ndarray, poses: Poses):
         """Hadamard ratio and det sign of the scale-free group Jacobian.
 
-        Columns of angles are multiplied by the mechanism size and angle rows divided by it, so
-        every entry is dimensionless; the ratio ``|det J| / prod(|row_i|)`` is 1 for orthogonal
-        rows and 0 at a singular (toggle) position. It costs one LU per position (an SVD costs
-        ten times more) and tracks the reciprocal condition number to within a modest factor.
+        Each link's rotation column is taken about the centroid of its joint points (a column
+        operation: the determinant is unchanged, but the measure no longer depends on where the
+        link's local origin lies); angle columns are multiplied by the mechanism size and angle
+        rows divided by it, so every entry is dimensionless. The ratio
+        ``|det J| / prod(|row_i|)`` is 1 for orthogonal rows and 0 at a singular (toggle)
+        position; it costs one LU per position (an SVD costs ten times more).
         """
+        scaled = phi_q.copy()
+        for i, link in enumerate(self.links):
+            rho = rotate(poses[link][:, 2], self._centroids[link])
+            c = 3 * i
+            scaled[:, :, c + 2] += scaled[:, :, c] * rho[:, None, 1] - scaled[:, :, c + 1] * rho[:, None, 0]
         rows = np.concatenate([j.row_scale(self.size) for j in self.joints])
         cols = np.tile([1.0, 1.0, 1.0 / self.size], len(self.links))
-        scaled = phi_q * rows[None, :, None] * cols[None, None, :]
+        scaled *= rows[None, :, None] * cols[None, None, :]
         det = np.linalg.det(scaled)
         norms = np.prod(np.linalg.norm(scaled, axis=2), axis=1)
         return np.abs(det) / np.where(norms > 0, norms, 1.0), np.sign(det)
@@ -351,7 +368,7 @@ class Group(ABC):
         if valid is None:
             ratio = np.zeros(len(ok))
             if ok.any():
-                ratio[ok] = self._conditioning(phi_q[ok])[0]
+                ratio[ok] = self._conditioning(phi_q[ok], {k: v[ok] for k, v in poses.items()})[0]
             ok &= ratio >= SINGULAR_TOL
         else:
             ok &= np.asarray(valid, bool)
