@@ -22,7 +22,7 @@ positive when it drives, speeds ``w = |omega|`` are positive.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any, Mapping
 
 import numpy as np
@@ -32,7 +32,6 @@ from scipy.optimize import brentq
 
 from .errors import LinkageError
 from .extremes import table_angles
-from .forces import loads_of
 from .kinematics import analyze
 from .kinetostatics import solve_reactions
 from .model import Mechanism, _is_number
@@ -316,12 +315,6 @@ def _override(mech, spec, delta, mean_speed) -> DynamicsSpec:
         if mean_speed == 0:
             raise ValueError("mean speed must be nonzero (its sign is the rotation)")
         changes["mean_speed"] = float(mean_speed)
-    return _replace(spec, **changes)
-
-
-def _replace(spec: DynamicsSpec, **changes) -> DynamicsSpec:
-    from dataclasses import replace
-
     return replace(spec, **changes)
 
 
@@ -392,7 +385,7 @@ def exact_method(mech: Mechanism, spec: DynamicsSpec | None = None, *, positions
     """
     spec = _override(mech, spec, delta, mean_speed)
     if positions is not None:
-        spec = _replace(spec, positions=positions)
+        spec = replace(spec, positions=positions)
     cycle = _fine_cycle(mech, spec, samples)
     wm = abs(spec.mean_speed)
     base = cycle.reduced.inertia_constant
@@ -558,7 +551,7 @@ def steady_state(mech: Mechanism, spec: DynamicsSpec | None = None, *, constant_
     """
     spec = dynamics_of(mech) if spec is None else spec
     if positions is not None:
-        spec = _replace(spec, positions=positions)
+        spec = replace(spec, positions=positions)
     constant = _default_constant(mech, spec) if constant_inertia is None else constant_inertia
     eq = _Equation(mech, spec, None, constant, samples)
     motor = eq.motor = _motor_of(spec, eq.cycle.driving)
@@ -692,7 +685,7 @@ def run_dynamics(mech: Mechanism, method: str = "course", *, positions: int | No
         raise ValueError(f"method must be 'course', 'exact' or 'ode', got {method!r}")
     spec = _override(mech, None, delta, mean_speed)
     if positions is not None:
-        spec = _replace(spec, positions=positions)
+        spec = replace(spec, positions=positions)
     comparison: dict[str, Any] = {}
     if method == "course":
         law = course_method(mech, spec)

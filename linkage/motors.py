@@ -134,7 +134,7 @@ def motor_from_spec(spec: Mapping[str, Any]) -> tuple[Any | None, list[str]]:
     args = {k: float(spec[k]) for k in given}
     if kind == "induction":
         if ("rated_moment" in args) == ("rated_power" in args):
-            return None, [f"motor (induction): give exactly one of rated_moment (N m) or rated_power (W)"]
+            return None, ["motor (induction): give exactly one of rated_moment (N m) or rated_power (W)"]
         if args["rated_rpm"] >= args["synchronous_rpm"]:
             return None, [f"motor (induction): rated_rpm {args['rated_rpm']} must be below "
                           f"synchronous_rpm {args['synchronous_rpm']}"]
