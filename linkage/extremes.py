@@ -92,19 +92,17 @@ def _find_extremes(mech: Mechanism, quantity: str, samples: int, xtol: float) ->
     grid = np.linspace(0.0, 2 * np.pi, samples, endpoint=False)
     motion = analyze(mech, grid, order=1, outputs=[quantity], on_failure="mask")
     d1 = motion.quantity(quantity)[1]
+    if not np.isfinite(d1).any():
+        raise ValueError(f"mechanism '{mech.name}' cannot be assembled at any input angle")
     if not np.nanmax(np.abs(d1)) > 1e-12 * mech.size:
         raise ValueError(f"'{quantity}' of mechanism '{mech.name}' does not move: it has no extreme "
                          "positions")
-    roots = []
-    for i in range(samples):  # cyclic: the last interval closes the revolution at 2 pi
-        a, b = d1[i], d1[(i + 1) % samples]
-        if not (np.isfinite(a) and np.isfinite(b)):
-            continue
-        if a == 0.0:
-            roots.append(grid[i])
-        elif a * b < 0:
-            roots.append(brentq(derivative, grid[i], grid[i] + 2 * np.pi / samples, xtol=xtol,
-                                rtol=4 * np.finfo(float).eps))
+    step = 2 * np.pi / samples
+    following = np.roll(d1, -1)  # cyclic: the last interval closes the revolution at 2 pi
+    valid = np.isfinite(d1) & np.isfinite(following)
+    roots = list(grid[valid & (d1 == 0.0)])
+    for i in np.flatnonzero(valid & (d1 * following < 0)):
+        roots.append(brentq(derivative, grid[i], grid[i] + step, xtol=xtol, rtol=4 * np.finfo(float).eps))
     if not roots:
         raise ValueError(f"'{quantity}' of mechanism '{mech.name}' has no extreme position: its first "
                          "analog does not change sign over a revolution")
