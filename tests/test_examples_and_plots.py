@@ -1,0 +1,68 @@
+"""The runnable examples run, and the plots draw what the analysis computed."""
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import matplotlib
+import numpy as np
+import pytest
+
+import linkage
+from linkage.report.plots import draw_mechanism, plot_columns
+
+matplotlib.use("Agg")
+
+ROOT = Path(__file__).resolve().parent.parent
+EXAMPLES = sorted((ROOT / "examples").glob("*.py"))
+
+
+def test_there_are_examples():
+    assert len(EXAMPLES) >= 2
+
+
+@pytest.mark.parametrize("script", EXAMPLES, ids=lambda p: p.stem)
+def test_example_runs_and_writes_its_pictures(script, tmp_path):
+    env = dict(os.environ, MPLBACKEND="Agg", PYTHONPATH=str(ROOT))
+    done = subprocess.run([sys.executable, str(script), str(tmp_path)], cwd=ROOT, env=env,
+                          capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert "Traceback" not in done.stderr
+    assert list(tmp_path.glob("*.png")), done.stdout
+
+
+def test_custom_mechanism_example_reports_the_lever_stroke(tmp_path):
+    """The lever press: a crank of 0.06 m at 0.15 m from the lever pivot swings the 0.4 m lever by
+    +-asin(0.06/0.15); the rod keeps the slider on the rail y = 0.45, so the stroke of F is the
+    difference of x_F = x_D + sqrt(0.2^2 - (0.45 - y_D)^2) at the two lever extremes."""
+    env = dict(os.environ, MPLBACKEND="Agg", PYTHONPATH=str(ROOT))
+    out = subprocess.run([sys.executable, str(ROOT / "examples" / "custom_mechanism.py"), str(tmp_path)],
+                         cwd=ROOT, env=env, capture_output=True, text=True, timeout=120).stdout
+    swing = np.arcsin(0.06 / 0.15)
+    x_f = [0.4 * np.sin(s) + np.sqrt(0.2**2 - (0.45 - 0.4 * np.cos(s)) ** 2) for s in (swing, -swing)]
+    stroke_mm = (x_f[0] - x_f[1]) * 1000
+    line = next(ln for ln in out.splitlines() if ln.startswith("stroke of F"))
+    assert float(line.split()[3]) == pytest.approx(stroke_mm, abs=0.01)
+
+
+@pytest.mark.parametrize("name", list(linkage.shipped_schemes()))
+def test_draw_mechanism_puts_every_pair_where_the_analysis_has_it(name):
+    mech = linkage.load(name)
+    motion = linkage.analyze(mech, np.radians([40.0]))
+    ax = draw_mechanism(motion, 0)
+    markers = np.array([line.get_xydata()[0] for line in ax.lines if line.get_marker() in ("o", "s")])
+    for pair in mech.pairs.values():
+        expected = motion.point(pair.point)[0]
+        assert np.min(np.hypot(*(markers - expected).T)) < 1e-12 * mech.size, pair.name
+    matplotlib.pyplot.close(ax.figure)
+
+
+def test_plot_columns_plots_the_columns_and_names_a_missing_one():
+    motion = linkage.analyze(linkage.load("four_bar"), np.radians(np.arange(0, 361, 30.0)))
+    cols = motion.columns()
+    ax = plot_columns(cols, ["3.theta'"])
+    np.testing.assert_array_equal(ax.lines[0].get_ydata(), cols["3.theta'"])
+    with pytest.raises(ValueError, match="no column 'nope'"):
+        plot_columns(cols, ["nope"])
+    matplotlib.pyplot.close("all")
