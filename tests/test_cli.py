@@ -7,8 +7,6 @@ from the library's output.
 
 from __future__ import annotations
 
-import csv
-import io
 import json
 import math
 import subprocess
@@ -19,7 +17,6 @@ import numpy as np
 import pytest
 
 import linkage
-from linkage.cli import main
 from linkage.report import format_columns
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -38,24 +35,7 @@ SL_O1, SL_R, SL_ROCKER, SL_RAM_Y = np.array([0.0, 0.12]), 0.076, 0.5, 0.25
 # ----------------------------------------------------------------------------------------------
 
 
-def run(capsys, *argv):
-    code = main(list(argv))
-    out, err = capsys.readouterr()
-    return code, out, err
-
-
-def read_csv(text):
-    rows = list(csv.reader(io.StringIO(text)))
-    header, body = rows[0], rows[1:]
-    data = np.array([[float(x) for x in r] for r in body])
-    return {name: data[:, k] for k, name in enumerate(header)}
-
-
-def read_table(text):
-    lines = [ln for ln in text.splitlines() if ln.strip() and not ln.startswith("#")]
-    header = lines[0].split()
-    data = np.array([[float(x) for x in ln.split()] for ln in lines[1:]])
-    return {name: data[:, k] for k, name in enumerate(header)}
+from _cli_io import read_csv, read_table, run  # noqa: E402
 
 
 def analyze_csv(capsys, scheme, *options):

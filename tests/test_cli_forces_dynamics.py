@@ -11,8 +11,6 @@ where the check is "the other columns follow from these".
 
 from __future__ import annotations
 
-import csv
-import io
 import json
 import math
 
@@ -20,7 +18,6 @@ import numpy as np
 import pytest
 
 import linkage
-from linkage.cli import main
 
 SHIPPED = list(linkage.shipped_schemes())
 
@@ -47,24 +44,7 @@ DYNAMICS_COLUMNS = ("phi_deg", "reduced_moment_resistance", "reduced_inertia",
 # ----------------------------------------------------------------------------------------------
 
 
-def run(capsys, *argv):
-    code = main([str(a) for a in argv])
-    out, err = capsys.readouterr()
-    return code, out, err
-
-
-def read_csv(text):
-    rows = list(csv.reader(io.StringIO(text)))
-    header, body = rows[0], rows[1:]
-    data = np.array([[float(x) for x in r] for r in body])
-    return {name: data[:, k] for k, name in enumerate(header)}
-
-
-def read_table(text):
-    lines = [ln for ln in text.splitlines() if ln.strip() and not ln.startswith("#")]
-    header = lines[0].split()
-    data = np.array([[float(x) for x in ln.split()] for ln in lines[1:]])
-    return {name: data[:, k] for k, name in enumerate(header)}
+from _cli_io import read_csv, read_table, run  # noqa: E402
 
 
 def json_doc(capsys, command, scheme, *options):
