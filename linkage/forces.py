@@ -86,7 +86,7 @@ class StrokeDiagram:
         """Signed load along the quantity at positions with the given value and analogs.
 
         At a stroke end the load is two-valued: a position counts in the stroke the mechanism
-        enters (sign of ``q''`` times the rotation), or in the one it leaves where ``ends`` is True.
+        enters (the sign of ``q''``, whatever the rotation), or in the one it leaves where ``ends`` is True.
         """
         ext = extreme_positions(mech, self.quantity)
         stroke = ext.value_max - ext.value_min
