@@ -19,7 +19,7 @@ from scipy.optimize import brentq
 from .kinematics import _cache, analyze
 from .model import Mechanism
 
-__all__ = ["Extremes", "extreme_positions", "table_angles"]
+__all__ = ["Extremes", "extreme_positions", "table_angles", "wrap_angle"]
 
 
 @dataclass(frozen=True)
@@ -48,6 +48,11 @@ class Extremes:
     def stroke(self) -> float:
         """``value_max - value_min``."""
         return self.value_max - self.value_min
+
+
+def wrap_angle(angle):
+    """Angles (rad) folded into [-pi, pi)."""
+    return np.mod(np.asarray(angle) + np.pi, 2 * np.pi) - np.pi
 
 
 def _output_quantity(mech: Mechanism, quantity: str | None) -> str:
@@ -109,6 +114,8 @@ def _find_extremes(mech: Mechanism, quantity: str, samples: int, xtol: float) ->
     roots = np.mod(roots, 2 * np.pi)
     roots = np.unique(np.where(roots > 2 * np.pi - 1e-12, 0.0, roots))
     values = analyze(mech, roots, order=0, outputs=[quantity]).quantity(quantity)[0]
+    if quantity.endswith(".theta"):  # angles: compare across the +-pi cut
+        values = values[0] + wrap_angle(values - values[0])
     i_max, i_min = int(np.argmax(values)), int(np.argmin(values))
     return Extremes(quantity, float(roots[i_max]), float(roots[i_min]), float(values[i_max]),
                     float(values[i_min]), roots)

@@ -33,7 +33,7 @@ from typing import Any, Mapping, Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .extremes import extreme_positions
+from .extremes import extreme_positions, wrap_angle
 from .kinematics import Motion
 from .model import Mechanism, _is_number
 from .scheme import SECTION_VALIDATORS
@@ -98,7 +98,10 @@ class StrokeDiagram:
         direction = np.where(at_end, entering_dir, moving)
         working = direction == self.working
         start = ext.value_min if self.working > 0 else ext.value_max
-        t = np.clip(np.abs(value - start) / stroke, 0.0, 1.0)
+        travel = value - start
+        if self.quantity.endswith(".theta"):  # a link angle may cross the +-pi cut
+            travel = wrap_angle(travel)
+        t = np.clip(np.abs(travel) / stroke, 0.0, 1.0)
         work_mag = np.interp(t, self.fractions, self.values)
         if self.idle_fractions:
             idle_mag = np.interp(1.0 - t, self.idle_fractions, self.idle_values)

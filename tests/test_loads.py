@@ -379,3 +379,29 @@ def test_gravity_is_the_declared_vector():
     expected = -(400.0 * 2.0 * xs2_1 + 500.0 * 2.0 * x_b_analog(phi))
     np.testing.assert_allclose(r.balancing_moment, expected, rtol=0,
                                atol=1e-9 * np.max(np.abs(expected)))
+
+
+def test_moment_diagram_on_a_rocker_whose_angle_crosses_the_pi_cut():
+    """The four-bar turned by 70 deg about O: its rocker swings through theta = 180 deg, where the
+    angle is reported as -180 deg. The swing (stroke) and a constant 10 N m resistance on the
+    working stroke (theta increasing) must not notice the cut: the turned mechanism is the same
+    machine, so its stroke equals the untouched four-bar's (found by its own closed form below)."""
+    d = to_dict(linkage.load("four_bar"))
+    a = np.radians(70.0)
+    d["links"]["0"]["points"] = {"O": [0.0, 0.0], "C": [0.3 * np.cos(a), 0.3 * np.sin(a)]}
+    d["loads"] = {"gravity": [0.0, 0.0], "moments": [{"link": "3", "diagram": {
+        "working": "+", "fractions": [0.0, 1.0], "values": [10.0, 10.0]}}]}
+    mech = from_dict(d)
+    # rocker extremes of the original four-bar: crank and coupler aligned (|CB| = 0.25, OC = 0.3)
+    def rocker_angle(reach):  # angle of CB when |OB| = reach, B above OC
+        cos_c = (0.3**2 + 0.25**2 - reach**2) / (2 * 0.3 * 0.25)
+        return np.pi - np.arccos(cos_c)
+    stroke = abs(rocker_angle(0.4) - rocker_angle(0.2))
+    ext = linkage.extreme_positions(mech, "3.theta")
+    assert ext.stroke == pytest.approx(stroke, abs=1e-10)
+    assert ext.value_min < np.pi < ext.value_max  # the swing straddles the cut
+    phi = np.linspace(0.0, 2 * np.pi, 37)[:-1]
+    motion = linkage.analyze(mech, phi, omega=1.0)
+    moment = evaluate_loads(motion, loads_of(mech))[0].moment
+    rising = motion.quantity("3.theta")[1] > 0
+    np.testing.assert_array_equal(moment, np.where(rising, -10.0, 0.0))
