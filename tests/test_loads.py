@@ -16,7 +16,7 @@ from scipy.optimize import brentq
 
 import linkage
 from linkage import SchemeError
-from linkage.forces import StrokeDiagram, evaluate_loads, loads_of
+from linkage.forces import LinkMoment, Loads, PointForce, StrokeDiagram, evaluate_loads, loads_of
 from linkage.kinetostatics import solve_reactions
 from linkage.scheme import from_dict, to_dict
 
@@ -405,3 +405,29 @@ def test_moment_diagram_on_a_rocker_whose_angle_crosses_the_pi_cut():
     moment = evaluate_loads(motion, loads_of(mech))[0].moment
     rising = motion.quantity("3.theta")[1] > 0
     np.testing.assert_array_equal(moment, np.where(rising, -10.0, 0.0))
+
+
+def test_per_position_force_and_moment_arrays():
+    """A force at E and a moment on the rocker that differ at every position: statics by virtual
+    work, M_b = -(F . E' + M theta3'), with E' and theta3' by central differences of positions."""
+    mech = linkage.load("four_bar")
+    phi = np.radians(np.arange(5.0, 360.0, 40.0))
+    n = len(phi)
+    force = np.column_stack([100.0 * np.cos(phi), -50.0 + 10.0 * np.arange(n)])
+    moment = 3.0 * np.sin(2 * phi)
+    loads = Loads(gravity=(0.0, 0.0), forces=(PointForce("E", "2", force),),
+                  moments=(LinkMoment("3", moment),))
+    reactions = solve_reactions(linkage.analyze(mech, phi), loads)
+    h = 1e-6
+    at = lambda p: linkage.analyze(mech, p, order=0)  # noqa: E731
+    e_prime = (at(phi + h).point("E") - at(phi - h).point("E")) / (2 * h)
+    t_prime = (at(phi + h).quantity("3.theta")[0] - at(phi - h).quantity("3.theta")[0]) / (2 * h)
+    expected = -(np.einsum("ni,ni->n", force, e_prime) + moment * t_prime)
+    np.testing.assert_allclose(reactions.balancing_moment, expected, rtol=1e-7, atol=1e-7)
+
+
+def test_per_position_force_of_the_wrong_shape_is_named():
+    mech = linkage.load("four_bar")
+    loads = Loads(forces=(PointForce("E", "2", np.zeros((3, 2))),))
+    with pytest.raises(ValueError, match=r"force at point 'E'.*shape \(5, 2\).*got shape \(3, 2\)"):
+        solve_reactions(linkage.analyze(mech, np.linspace(0, 1, 5)), loads)
