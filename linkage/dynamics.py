@@ -571,8 +571,8 @@ def steady_state(mech: Mechanism, spec: DynamicsSpec | None = None, *, constant_
                                 f"keep the mean speed {abs(spec.mean_speed):.6g} rad/s (it would stop "
                                 "within the cycle): add a flywheel")
         energy0 = i0 * w[0] ** 2 / 2
-        imbalance = 2 * np.pi * motor.moment + (eq.cycle.energy[-1] - 2 * np.pi * eq.cycle.driving)
-        if abs(imbalance) > 1e-6 * max(eq.scale, 1e-300) * 2 * np.pi:
+        # a constant moment other than the cycle's balancing one gains or loses energy every cycle
+        if abs(motor.moment - eq.cycle.driving) > 1e-6 * max(eq.scale, 1e-300):
             raise DynamicsError(f"{name}: the constant driving moment {motor.moment:.6g} N m does not "
                                 f"balance the cycle's resistance ({eq.cycle.driving:.6g} N m needed): no "
                                 "periodic steady state")
