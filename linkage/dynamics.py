@@ -414,7 +414,7 @@ def exact_method(mech: Mechanism, spec: DynamicsSpec | None = None, *, positions
                        None if flywheel is None else float(flywheel), _delta(w, wm), float(constant),
                        spec.rotation * w_table,
                        _eps(red, cycle.driving, constant + red.inertia_variable, w_table),
-                       {"samples": len(cycle.psi) - 1})
+                       {"samples": len(cycle.psi) - 1, "fine_cycle": cycle})
 
 
 def _pick(red: Reduced, index) -> Reduced:
@@ -695,7 +695,7 @@ def run_dynamics(mech: Mechanism, method: str = "course", *, positions: int | No
                 "exact_required_constant_inertia": exact.required_constant_inertia,
                 "exact_flywheel_inertia": exact.flywheel_inertia,
                 "course_vs_exact_inertia": law.required_constant_inertia / exact.required_constant_inertia - 1,
-                "course_delta_exact": _course_delta_exactly(mech, spec, law),
+                "course_delta_exact": _course_delta_exactly(spec, law, exact),
             }
     elif method == "exact":
         law = exact_method(mech, spec)
@@ -728,9 +728,9 @@ def _settling(mech: Mechanism, spec: DynamicsSpec, law: LawOfMotion) -> dict[str
             "settling_time": settled}
 
 
-def _course_delta_exactly(mech: Mechanism, spec: DynamicsSpec, law: LawOfMotion) -> float:
-    """The delta a machine sized by the course method really has (exact energy solution)."""
-    cycle = _fine_cycle(mech, spec, 3600)
-    constant = max(law.required_constant_inertia, cycle.reduced.inertia_constant)
+def _course_delta_exactly(spec: DynamicsSpec, law: LawOfMotion, exact: LawOfMotion) -> float:
+    """The delta a machine sized by the course method really has: the exact energy solution on
+    the exact method's fine grid with the course method's constant inertia."""
+    cycle = exact.details["fine_cycle"]
     wm = abs(spec.mean_speed)
-    return _delta(_speeds(cycle, constant, wm), wm)
+    return _delta(_speeds(cycle, law.constant_inertia, wm), wm)

@@ -15,7 +15,7 @@ Results are exact: positions by each group's closed form, first and second trans
 from __future__ import annotations
 
 import warnings
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Iterable, Literal
 
 import numpy as np
@@ -25,7 +25,7 @@ from assur.base import CANNOT_ASSEMBLE, OK, SINGULAR, global_point, perp, point_
 
 from .errors import AssemblyError, SchemeError, StructureError
 from .model import Mechanism, Prismatic
-from .structure import Structure, decompose, joint_of
+from .structure import Structure, decompose
 
 __all__ = ["Motion", "analyze", "structure_of", "assembly_branches", "BranchWarning", "parse_quantity"]
 
@@ -79,7 +79,11 @@ class Motion:
     status: np.ndarray
     omega: np.ndarray | None = None
     eps: np.ndarray | None = None
-    joints: dict = field(default_factory=dict, repr=False)
+
+    @property
+    def joints(self) -> dict:
+        """Pair name -> solver-side joint (from the structure)."""
+        return self.structure.joints
 
     @property
     def success(self) -> np.ndarray:
@@ -267,9 +271,8 @@ def analyze(
     if omega is not None:
         omega_arr = np.broadcast_to(np.asarray(omega, dtype=float), phi.shape).copy()
         eps_arr = np.broadcast_to(np.asarray(0.0 if eps is None else eps, dtype=float), phi.shape).copy()
-    joints = {name: joint_of(p, mech) for name, p in mech.pairs.items()}
     return Motion(mech, structure, phi, poses, first if order >= 1 else None,
-                  second if order >= 2 else None, status, omega_arr, eps_arr, joints)
+                  second if order >= 2 else None, status, omega_arr, eps_arr)
 
 
 def _links_of(mech: Mechanism, outputs: Iterable[str]) -> list[str]:

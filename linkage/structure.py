@@ -36,6 +36,8 @@ class Structure:
         Input links, each forming a class-I mechanism with the frame.
     input_joints : dict
         Input link -> the revolute joint pinning it to the frame.
+    joints : dict
+        Pair name -> its solver-side joint (local geometry resolved), for every pair.
     groups : tuple of Group
         Bound group solvers in the order of kinematic analysis.
     """
@@ -44,6 +46,7 @@ class Structure:
     inputs: tuple[str, ...]
     input_joints: dict[str, RevoluteJoint]
     groups: tuple[Group, ...]
+    joints: dict[str, RevoluteJoint | PrismaticJoint]
 
     @property
     def formula(self) -> str:
@@ -131,7 +134,7 @@ def decompose(mech: Mechanism) -> Structure:
         known |= set(group.links)
         used |= {j.name for j in group.joints}
         unknown = [k for k in unknown if k not in known]
-    return Structure(mech.frame, tuple(mech.inputs), input_joints, tuple(groups))
+    return Structure(mech.frame, tuple(mech.inputs), input_joints, tuple(groups), joints)
 
 
 def _group_joints(subset, known, joints, used):
