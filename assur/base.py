@@ -38,6 +38,8 @@ from typing import ClassVar, Mapping, Sequence
 import numpy as np
 
 __all__ = [
+    "ANALOG_TOL",
+    "SINGULAR_TOL",
     "OK",
     "CANNOT_ASSEMBLE",
     "SINGULAR",
@@ -55,8 +57,15 @@ OK, CANNOT_ASSEMBLE, SINGULAR = 0, -1, -2
 
 #: relative closure residual above which a closed-form position counts as not assembled
 CLOSURE_TOL = 1e-9
-#: Hadamard ratio of the scaled group Jacobian below which a position is singular
-SINGULAR_TOL = 1e-9
+#: the status-OK guarantee: first analogs accurate to this, relative to the largest first analog
+#: of the group and of the links it attaches to (second analogs: 10 times this)
+ANALOG_TOL = 1e-8
+#: round-off model of a group's first analogs: relative error <= ROUNDOFF_FACTOR * eps / r**2
+#: for conditioning r (measured factor <= 0.26 for every dyad kind in benchmarks/results_guarantee.md;
+#: ten times that for a margin)
+ROUNDOFF_FACTOR = 3.0
+#: conditioning below which a group alone cannot keep the guarantee (about 2.6e-4)
+SINGULAR_TOL = float(np.sqrt(ROUNDOFF_FACTOR * np.finfo(float).eps / ANALOG_TOL))
 
 Poses = Mapping[str, np.ndarray]
 
@@ -227,13 +236,6 @@ class PrismaticJoint:
 Joint = RevoluteJoint | PrismaticJoint
 
 
-def _local_points(joint: Joint, link: str):
-    """The local point(s) by which ``joint`` acts on ``link``."""
-    if isinstance(joint, RevoluteJoint):
-        return joint.local(link)[0]
-    return joint.g if link == joint.a else joint.p
-
-
 # ----------------------------------------------------------------------------------------------
 # the group protocol
 # ----------------------------------------------------------------------------------------------
@@ -246,6 +248,8 @@ class GroupPosition:
     poses: dict[str, np.ndarray]
     status: np.ndarray
     jacobian_sign: np.ndarray  # sign of det of the group Jacobian (0 where not assembled)
+    conditioning: np.ndarray   # :meth:`Group.conditioning` ratio (NaN where not assembled)
+    error_bound: np.ndarray    # bound of the relative error of the first analogs (inf: not assembled)
 
 
 class Group(ABC):
@@ -270,9 +274,6 @@ class Group(ABC):
         self.joints = tuple(joints)
         self.size = float(size)
         self.known_links = tuple(sorted(({j.a for j in joints} | {j.b for j in joints}) - set(links)))
-        # each link's joint points (local), whose centroid the singularity measure rotates about
-        self._centroids = {link: np.mean([_local_points(j, link) for j in self.joints
-                                          if link in (j.a, j.b)], axis=0) for link in self.links}
 
     # -- binding -------------------------------------------------------------------------------
     @classmethod
@@ -289,8 +290,14 @@ class Group(ABC):
         return f"{self.group_class}-{self.kind}({','.join(self.links)})"
 
     # -- position ------------------------------------------------------------------------------
-    def position(self, poses: Poses, branch: int = 1) -> GroupPosition:
-        """Poses of the group's links given the known ``poses``; checks closure and singularity."""
+    def position(self, poses: Poses, branch: int = 1, input_error=0.0) -> GroupPosition:
+        """Poses of the group's links given the known ``poses``; checks closure and singularity.
+
+        A position is singular (status -2) where the bound of the relative error of the first
+        analogs, ``ROUNDOFF_FACTOR * eps / r**2 + input_error / r`` for the group's
+        :meth:`conditioning` r, exceeds ``ANALOG_TOL``: the group's own round-off plus the error
+        of the known links' analogs (``input_error``, scalar or ``(N,)``) amplified by the solve.
+        """
         if branch not in self.branches:
             raise ValueError(f"{self!r}: branch must be one of {self.branches}, got {branch!r}")
         new, assembled = self._position(poses, branch)
@@ -300,14 +307,21 @@ class Group(ABC):
         assembled = assembled & np.isfinite(closure) & (closure <= CLOSURE_TOL * self.size)
         status = np.where(assembled, OK, CANNOT_ASSEMBLE)
         sign = np.zeros(len(status))
+        conditioning = np.full(len(status), np.nan)
+        bound = np.full(len(status), np.inf)
         if assembled.any():
             regular = {k: v[assembled] for k, v in merged.items()}
-            ratio, det_sign = self._conditioning(self.jacobians(regular)[0], regular)
-            status[np.flatnonzero(assembled)[ratio < SINGULAR_TOL]] = SINGULAR
+            ratio, det_sign = self.conditioning(self.jacobians(regular)[0], regular)
             sign[assembled] = det_sign
+            conditioning[assembled] = ratio
+            incoming = np.broadcast_to(np.asarray(input_error, float), status.shape)[assembled]
+            with np.errstate(divide="ignore", invalid="ignore"):
+                own = np.where(ratio > 0, ROUNDOFF_FACTOR * np.finfo(float).eps / ratio**2, np.inf)
+                bound[assembled] = own + np.where(incoming > 0, incoming / ratio, 0.0)
+            status[assembled & ~(bound <= ANALOG_TOL)] = SINGULAR
         for k in new:
             new[k] = np.where(assembled[:, None], new[k], np.nan)
-        return GroupPosition(new, status, sign)
+        return GroupPosition(new, status, sign, conditioning, bound)
 
     @abstractmethod
     def _position(self, poses: Poses, branch: int):
@@ -333,24 +347,61 @@ class Group(ABC):
                     phi_k[link][:, 2 * r : 2 * r + 2, :] += block
         return phi_q, phi_k
 
-    def _conditioning(self, phi_q: np.ndarray, poses: Poses):
-        """Hadamard ratio and det sign of the scale-free group Jacobian.
+    def contact_points(self, poses: Poses) -> np.ndarray:
+        """Global points ``(N, n_joints, 2)`` where the group's pairs act, m.
 
-        Each link's rotation column is taken about the centroid of its joint points (a column
-        operation: the determinant is unchanged, but the measure no longer depends on where the
-        link's local origin lies); angle columns are multiplied by the mechanism size and angle
-        rows divided by it, so every entry is dimensionless. The ratio
-        ``|det J| / prod(|row_i|)`` is 1 for orthogonal rows and 0 at a singular (toggle)
-        position; it costs one LU per position (an SVD costs ten times more).
+        A revolute pair acts at its pin; a prismatic pair at the slider's point on the guide.
         """
+        points = []
+        for j in self.joints:
+            if isinstance(j, RevoluteJoint):
+                points.append(global_point(poses[j.a], j.pa))
+            else:
+                points.append(global_point(poses[j.b], j.p))
+        return np.stack(points, axis=1)
+
+    def conditioning(self, phi_q: np.ndarray, poses: Poses) -> tuple[np.ndarray, np.ndarray]:
+        """Scale-free conditioning of the group Jacobian and the sign of its determinant.
+
+        The measure is the Hadamard ratio ``|det J| / prod(|row_i|)`` of the group Jacobian made
+        dimensionless *at the group's own scale* ``L`` (the largest distance between the points
+        where its pairs act, see :meth:`contact_points`): each link's rotation column is taken
+        about the centroid of that link's contact points (a column operation that leaves the
+        determinant unchanged but frees the measure from where the local origin lies) and
+        divided by ``L``; angle rows of prismatic pairs are multiplied by ``L``. The ratio is 1
+        for orthogonal rows and falls to 0 at a singular (toggle, parallel-guide) position; for
+        the RRR dyad it behaves like the sine of the transmission angle. It does not depend on
+        the size of the rest of the mechanism, on its units or on where the group lies.
+
+        Parameters
+        ----------
+        phi_q : ndarray, shape (N, m, m)
+            The group Jacobian (:meth:`jacobians`).
+        poses : dict
+            Poses ``(N, 3)`` of the group's and known links.
+
+        Returns
+        -------
+        ratio : ndarray, shape (N,)
+            The conditioning measure in [0, 1].
+        sign : ndarray, shape (N,)
+            Sign of ``det(phi_q)``.
+        """
+        contacts = self.contact_points(poses)                          # (N, J, 2)
+        spread = np.linalg.norm(contacts[:, :, None, :] - contacts[:, None, :, :], axis=-1)
+        scale = np.max(spread, axis=(1, 2))
+        floor = 1e-12 * np.max(np.abs(contacts), axis=(1, 2))       # round-off of the coordinates
+        scale = np.maximum(scale, floor)
+        scale = np.where(scale > 0, scale, 1.0)[:, None, None]
         scaled = phi_q.copy()
         for i, link in enumerate(self.links):
-            rho = rotate(poses[link][:, 2], self._centroids[link])
+            mine = [r for r, j in enumerate(self.joints) if link in (j.a, j.b)]
+            rho = contacts[:, mine].mean(axis=1) - poses[link][:, :2]
             c = 3 * i
             scaled[:, :, c + 2] += scaled[:, :, c] * rho[:, None, 1] - scaled[:, :, c + 1] * rho[:, None, 0]
-        rows = np.concatenate([j.row_scale(self.size) for j in self.joints])
-        cols = np.tile([1.0, 1.0, 1.0 / self.size], len(self.links))
-        scaled *= rows[None, :, None] * cols[None, None, :]
+            scaled[:, :, c + 2:c + 3] /= scale
+        angle_rows = [2 * r + 1 for r, j in enumerate(self.joints) if isinstance(j, PrismaticJoint)]
+        scaled[:, angle_rows, :] *= scale
         det = np.linalg.det(scaled)
         norms = np.prod(np.linalg.norm(scaled, axis=2), axis=1)
         return np.abs(det) / np.where(norms > 0, norms, 1.0), np.sign(det)
@@ -368,7 +419,7 @@ class Group(ABC):
         if valid is None:
             ratio = np.zeros(len(ok))
             if ok.any():
-                ratio[ok] = self._conditioning(phi_q[ok], {k: v[ok] for k, v in poses.items()})[0]
+                ratio[ok] = self.conditioning(phi_q[ok], {k: v[ok] for k, v in poses.items()})[0]
             ok &= ratio >= SINGULAR_TOL
         else:
             ok &= np.asarray(valid, bool)

@@ -68,6 +68,14 @@ class Motion:
         0 ok, -1 cannot be assembled, -2 singular (analogs unbounded; they are NaN there).
     omega, eps : ndarray (N,) or None
         Input angular velocity (rad/s) and acceleration (rad/s^2) for real velocities.
+    conditioning : dict of group label -> ndarray (N,)
+        Each analysed group's scale-free distance from a singular position (the conditioning
+        ratio of ``assur.Group.conditioning``: 1 well conditioned, 0 singular; NaN where the
+        group is not assembled), e.g. ``motion.conditioning["II-RRR(2,3)"]``.
+    error_bound : ndarray (N,)
+        Bound of the relative error of the first analogs at each position (the status-OK
+        guarantee: at most ``assur.ANALOG_TOL`` = 1e-8 where the status is 0; inf where a
+        group is not assembled).
     """
 
     mechanism: Mechanism
@@ -79,6 +87,8 @@ class Motion:
     status: np.ndarray
     omega: np.ndarray | None = None
     eps: np.ndarray | None = None
+    conditioning: dict[str, np.ndarray] | None = None
+    error_bound: np.ndarray | None = None
 
     @property
     def joints(self) -> dict:
@@ -249,10 +259,15 @@ def analyze(
         structure.needed_groups(_links_of(mech, outputs))
     poses, first, second = _input_state(mech, structure, phi, order)
     status = np.full(len(phi), OK)
+    error = {link: np.zeros(len(phi)) for link in poses}   # relative error of each link's analogs
+    conditioning = {}
     for i in group_ids:
         group = structure.groups[i]
-        placed = group.position(poses, branches[i])
+        incoming = np.max([error[k] for k in group.known_links], axis=0)
+        placed = group.position(poses, branches[i], incoming)
         poses.update(placed.poses)
+        error.update({link: placed.error_bound for link in group.links})
+        conditioning[repr(group)] = placed.conditioning
         status = np.where(status == OK, placed.status, status)
         _check_continuity(group, placed, phi)
         if order >= 1:
@@ -272,7 +287,8 @@ def analyze(
         omega_arr = np.broadcast_to(np.asarray(omega, dtype=float), phi.shape).copy()
         eps_arr = np.broadcast_to(np.asarray(0.0 if eps is None else eps, dtype=float), phi.shape).copy()
     return Motion(mech, structure, phi, poses, first if order >= 1 else None,
-                  second if order >= 2 else None, status, omega_arr, eps_arr)
+                  second if order >= 2 else None, status, omega_arr, eps_arr, conditioning,
+                  np.max(list(error.values()), axis=0))
 
 
 def _links_of(mech: Mechanism, outputs: Iterable[str]) -> list[str]:
