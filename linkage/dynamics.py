@@ -22,6 +22,7 @@ positive when it drives, speeds ``w = |omega|`` are positive.
 from __future__ import annotations
 
 import math
+import sys
 from dataclasses import dataclass, field, replace
 from typing import Any, Mapping
 
@@ -41,6 +42,7 @@ from .scheme import SECTION_VALIDATORS
 
 __all__ = [
     "DynamicsError",
+    "DynamicsInputError",
     "DynamicsSpec",
     "LawOfMotion",
     "Transient",
@@ -55,7 +57,83 @@ __all__ = [
 
 
 class DynamicsError(LinkageError):
-    """The machine stalls, runs away, or the steady state cannot be found."""
+    """The machine stalls, runs away, the steady state cannot be found, or the problem's numbers
+    leave float64's range (the message says which quantity and why)."""
+
+
+class DynamicsInputError(DynamicsError, ValueError):
+    """An argument of a dynamics function is out of range; the message names it and its value.
+
+    Also a ``ValueError``, so code that catches ``ValueError`` for bad arguments keeps working.
+    """
+
+
+#: The exact energy method resolves ``delta`` from speeds computed in float64: each carries a
+#: relative rounding error of a few 1e-16, so the computed delta is uncertain by ~1e-15 and the
+#: constant inertia found for it by ~1e-15 / delta (relative). Below this delta the answer would
+#: be mostly rounding: :func:`exact_method` refuses it (Mertsalov's :func:`course_method`, exact
+#: in the limit delta -> 0, has no such floor).
+DELTA_RESOLVED = 1e-9
+
+#: ``k_dyn`` is reported only when ``|M_d|`` exceeds this fraction of the machine's moment scale
+#: (the largest of ``|M_b|`` and ``|M_red|`` over the cycle): below it the mean driving moment is
+#: round-off of a cycle that needs no net drive (conservative loads), and their ratio means nothing.
+MEAN_MOMENT_RESOLVED = 1e-9
+
+
+def _real(value: Any) -> bool:
+    """A finite real number (not a bool)."""
+    return (isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, (bool, np.bool_))
+            and math.isfinite(value))
+
+
+def _require(ok: bool, name: str, value: Any, rule: str) -> None:
+    if not ok:
+        raise DynamicsInputError(f"{name} must be {rule}, got {value!r}")
+
+
+def _require_count(name: str, value: Any) -> None:
+    _require(isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_)) and value >= 1,
+             name, value, "a positive integer")
+
+
+def _check_spec(spec: DynamicsSpec) -> DynamicsSpec:
+    """``spec`` after checking every value the solvers rely on (DynamicsInputError naming the first
+    bad one): the same rules whether the spec came from a scheme file or was built in Python."""
+    if not isinstance(spec, DynamicsSpec):
+        raise DynamicsInputError(f"spec must be a DynamicsSpec, got {spec!r}")
+    w = spec.mean_speed
+    _require(_real(w) and w != 0, "mean_speed", w, "a finite nonzero number (rad/s; its sign is the rotation)")
+    w2 = float(w) * float(w)  # python floats: inf or 0.0 on overflow, never an exception
+    _require(math.isfinite(w2) and w2 >= sys.float_info.min, "mean_speed", w,
+             "a speed whose square (the scale of the kinetic energy) float64 holds: "
+             f"{math.sqrt(sys.float_info.min):.3g} <= |mean_speed| <= {math.sqrt(sys.float_info.max):.3g} rad/s")
+    _require(spec.delta is None or (_real(spec.delta) and 0 < spec.delta < 2), "delta", spec.delta,
+             "a number in (0, 2): (omega_max - omega_min) / omega_m reaches 2 only when omega_min = 0")
+    _require_count("positions", spec.positions)
+    _require_count("cycles", spec.cycles)
+    for name in ("inertia_0", "flywheel"):
+        value = getattr(spec, name)
+        _require(_real(value) and value >= 0, name, value, "a finite number >= 0 (kg m^2)")
+    for i, rotor in enumerate(spec.rotors):
+        ok = isinstance(rotor, tuple) and len(rotor) == 2 and _real(rotor[0]) and rotor[0] >= 0 and _real(rotor[1])
+        _require(ok, f"rotors[{i}]", rotor, "(inertia >= 0 in kg m^2, finite gear ratio U)")
+    _require(math.isfinite(spec.constant_inertia), "the constant inertia inertia_0 + sum(J U^2) + flywheel",
+             spec.constant_inertia, "finite in float64 (kg m^2)")
+    _require(spec.initial_speed is None or (_real(spec.initial_speed) and spec.initial_speed > 0), "initial_speed",
+             spec.initial_speed, "a finite number > 0 (|omega| at the start, rad/s)")
+    _require(spec.motor is None or callable(spec.motor), "motor", spec.motor,
+             "a motor characteristic motor(w) -> M (linkage.motors)")
+    return spec
+
+
+def _kinetic_energy(inertia: float, speed: float, what: str) -> float:
+    """``inertia speed^2 / 2`` (J) in float64; DynamicsError naming ``what`` when it overflows."""
+    energy = float(inertia) * float(speed) * float(speed) / 2  # python floats: inf, never an exception
+    if not math.isfinite(energy):
+        raise DynamicsError(f"{what}: the kinetic energy I w^2 / 2 = {float(inertia):.6g} kg m^2 x "
+                            f"({float(speed):.6g} rad/s)^2 / 2 overflows float64")
+    return energy
 
 
 # ----------------------------------------------------------------------------------------------

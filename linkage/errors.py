@@ -4,12 +4,17 @@
 
 - :class:`SchemeError` -- a mechanism is declared wrongly (bad file, unknown link, bad value);
 - :class:`StructureError` -- the mechanism's structure is wrong (mobility, not decomposable);
-- :class:`AssemblyError` -- a group cannot be assembled at some input angles.
+- :class:`AssemblyError` -- a group cannot be assembled at some input angles;
+- :class:`InputError` -- a function of the library was called with a bad argument (an order, a
+  direction, a motion without the analogs a computation needs).
+
+:class:`SchemeError` and :class:`InputError` are also ``ValueError`` s, so code that catches
+``ValueError`` keeps working.
 """
 
 from __future__ import annotations
 
-__all__ = ["LinkageError", "SchemeError", "StructureError", "AssemblyError"]
+__all__ = ["LinkageError", "SchemeError", "StructureError", "AssemblyError", "InputError"]
 
 
 class LinkageError(Exception):
@@ -46,3 +51,8 @@ class AssemblyError(LinkageError):
     def __init__(self, message: str, angles_deg=()):
         self.angles_deg = angles_deg
         super().__init__(message)
+
+
+class InputError(LinkageError, ValueError):
+    """A function was called with a bad argument (a value out of its range, a motion without the
+    analogs or speeds the computation needs, an unknown name)."""

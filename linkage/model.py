@@ -21,6 +21,7 @@ Build one with :class:`MechanismBuilder` (the scheme loader uses the same builde
 
 from __future__ import annotations
 
+import difflib
 import math
 from dataclasses import dataclass, field
 from functools import cached_property
@@ -39,6 +40,11 @@ __all__ = [
     "Output",
     "Mechanism",
     "MechanismBuilder",
+    "MAX_MAGNITUDE",
+    "MIN_MAGNITUDE",
+    "MAX_ANGLE_DEG",
+    "check_number",
+    "unknown_keys",
 ]
 
 Vec = tuple[float, float]
@@ -185,6 +191,14 @@ class Mechanism:
     extra: Mapping[str, Any] = field(default_factory=dict, compare=True)
 
     @cached_property
+    def parts(self) -> dict[str, Any]:
+        """Typed parts parsed once from the further sections of ``extra`` (``"loads"`` ->
+        :class:`~linkage.forces.Loads`, ``"dynamics"`` -> :class:`~linkage.dynamics.DynamicsSpec`
+        or None): filled when a scheme is loaded, or on first use by
+        :func:`linkage.scheme.section_of`. Not part of the mechanism's identity (equality)."""
+        return {}
+
+    @cached_property
     def graph(self) -> nx.MultiGraph:
         """Links as nodes (attribute ``link``), pairs as edges (key = pair name, ``pair``)."""
         g = nx.MultiGraph(name=self.name)
@@ -245,6 +259,95 @@ class Mechanism:
 # ----------------------------------------------------------------------------------------------
 
 
+#: Largest magnitude of a number in a declaration (a length, coordinate, mass, inertia, force,
+#: moment, speed, ratio ...). The pipeline multiplies up to six declared numbers (a kinetic energy
+#: ``m l^2 omega^2`` has five factors, a dyad's Jacobian determinant three lengths); with every
+#: factor within [1e-50, 1e50] such a product stays within [1e-300, 1e300]: finite, and above the
+#: smallest normal float64 (2.2e-308). Documented in ``schemes/README.md`` ("Ranges").
+MAX_MAGNITUDE = 1e50
+#: Smallest magnitude of a number that must be positive or nonzero because it sets a scale or
+#: divides (a link's length, a speed, a gear ratio ...); see :data:`MAX_MAGNITUDE`.
+MIN_MAGNITUDE = 1e-50
+#: Largest magnitude of an angle, degrees: beyond it a float64 no longer holds the angle to
+#: 1e-10 of a degree (its spacing at 1e6 is 1.2e-10).
+MAX_ANGLE_DEG = 1e6
+
+_RANGES = {
+    # kind: (test, description)
+    "real": (lambda v: abs(v) <= MAX_MAGNITUDE, f"a number with |x| <= {MAX_MAGNITUDE:g}"),
+    "nonnegative": (lambda v: 0 <= v <= MAX_MAGNITUDE, f"a number in [0, {MAX_MAGNITUDE:g}]"),
+    "positive": (lambda v: MIN_MAGNITUDE <= v <= MAX_MAGNITUDE,
+                 f"a number in [{MIN_MAGNITUDE:g}, {MAX_MAGNITUDE:g}]"),
+    "nonzero": (lambda v: MIN_MAGNITUDE <= abs(v) <= MAX_MAGNITUDE,
+                f"a nonzero number with {MIN_MAGNITUDE:g} <= |x| <= {MAX_MAGNITUDE:g}"),
+    "angle_deg": (lambda v: abs(v) <= MAX_ANGLE_DEG, f"a number with |x| <= {MAX_ANGLE_DEG:g}"),
+    "angle": (lambda v: abs(v) <= math.radians(MAX_ANGLE_DEG),
+              f"a number with |x| <= {math.radians(MAX_ANGLE_DEG):.6g}"),
+    "fraction": (lambda v: 0 <= v <= 1, "a number in [0, 1]"),
+}
+
+
+def check_number(value: Any, where: str, what: str, problems: list[str], kind: str = "real",
+                 unit: str = "") -> float | None:
+    """``float(value)`` when it is a finite number in the range ``kind``; else None, with a problem.
+
+    Parameters
+    ----------
+    value : Any
+        The declared value.
+    where, what : str
+        The entry (``"link '2'"``, ``"pairs.slide"``) and the key (``"length"``) for the message.
+    problems : list of str
+        Where the problem is appended.
+    kind : {"real", "nonnegative", "positive", "nonzero", "angle_deg", "angle", "fraction"}
+        The range (see :data:`MAX_MAGNITUDE` and ``schemes/README.md``).
+    unit : str
+        Unit shown in the message ("m", "kg").
+
+    Returns
+    -------
+    float or None
+
+    Examples
+    --------
+    >>> problems = []
+    >>> check_number(1e200, "link '2'", "length", problems, "positive", "m")
+    >>> problems
+    ["link '2': length must be a number in [1e-50, 1e+50] m, got 1e+200"]
+    """
+    test, description = _RANGES[kind]
+    if _is_number(value) and test(value):
+        return float(value)
+    problems.append(f"{where}: {what} must be {description}{' ' + unit if unit else ''}, got {value!r}")
+    return None
+
+
+def unknown_keys(spec: Mapping[str, Any], known, where: str, problems: list[str]) -> bool:
+    """Report the keys of ``spec`` that are not in ``known``, suggesting the known key meant.
+
+    Returns True when an unknown key looks like a misspelling of a known key that ``spec`` lacks
+    (``link`` for ``links``): the entry is then incomplete, and the caller skips it instead of
+    reporting the missing key as a second problem of the same cause.
+
+    Examples
+    --------
+    >>> problems = []
+    >>> unknown_keys({"link": ["1", "2"]}, {"links", "kind", "at"}, "pairs.A", problems)
+    True
+    >>> problems
+    ["pairs.A: unknown keys ['link'] (known: ['at', 'kind', 'links']); did you mean 'links'?"]
+    """
+    bad = sorted(k for k in spec if k not in known)
+    if not bad:
+        return False
+    absent = sorted(k for k in known if k not in spec)
+    meant = {k: difflib.get_close_matches(str(k), absent, n=1, cutoff=0.75) for k in bad}
+    hints = [f"'{m[0]}'" for m in meant.values() if m]
+    hint = f"; did you mean {', '.join(hints)}?" if hints else ""
+    problems.append(f"{where}: unknown keys {bad} (known: {sorted(known)}){hint}")
+    return bool(hints)
+
+
 def _angle(spec: Mapping[str, Any], key: str, where: str, problems: list[str], default=0.0):
     """Read ``key`` (rad) or ``key_deg`` (deg) from ``spec``; return radians."""
     has_rad, has_deg = key in spec, f"{key}_deg" in spec
@@ -254,10 +357,12 @@ def _angle(spec: Mapping[str, Any], key: str, where: str, problems: list[str], d
     raw = spec.get(key, spec.get(f"{key}_deg", None))
     if raw is None:
         return default
-    if not _is_number(raw):
-        problems.append(f"{where}: '{key}{'_deg' if has_deg else ''}' must be a number, got {raw!r}")
+    name = f"{key}_deg" if has_deg else key
+    value = check_number(raw, where, f"'{name}'", problems, "angle_deg" if has_deg else "angle",
+                         "deg" if has_deg else "rad")
+    if value is None:
         return default
-    return math.radians(raw) if has_deg else float(raw)
+    return math.radians(value) if has_deg else value
 
 
 def _is_number(x: Any) -> bool:
@@ -268,6 +373,18 @@ def _vector(raw: Any) -> Vec | None:
     if isinstance(raw, (list, tuple)) and len(raw) == 2 and all(_is_number(v) for v in raw):
         return (float(raw[0]), float(raw[1]))
     return None
+
+
+def _coordinates(raw: Any, where: str, expected: str, problems: list[str]) -> Vec | None:
+    """``(x, y)`` of a declared ``[x, y]``, or None with a problem: not a pair of finite numbers
+    (the message says ``expected``), or a coordinate out of range (:data:`MAX_MAGNITUDE`)."""
+    vec = _vector(raw)
+    if vec is None:
+        problems.append(f"{where}: expected {expected}, got {raw!r}")
+    elif not all(abs(c) <= MAX_MAGNITUDE for c in vec):
+        problems.append(f"{where}: coordinates must be numbers with |x| <= {MAX_MAGNITUDE:g} m, got {raw!r}")
+        vec = None
+    return vec
 
 
 class MechanismBuilder:
@@ -287,6 +404,8 @@ class MechanismBuilder:
         self._assembly: list[Assembly] = []
         self._output: Output | None = None
         self._problems: list[str] = []
+        self._rejected: set[str] = set()
+        self._unplaced: dict[str, set[str]] = {}
 
     # -- links ---------------------------------------------------------------------------------
     def link(
@@ -325,90 +444,100 @@ class MechanismBuilder:
             p.append(f"{where}: declared twice")
             return self
         local: dict[str, Vec] = {}
+        unplaced = self._unplaced.setdefault(name, set())  # declared, but refused: no follow-ons
         if line is not None or length is not None:
             if line is None or len(line) != 2 or not all(isinstance(s, str) for s in line):
                 p.append(f"{where}: 'line' must name two points, got {line!r}")
             elif line[0] == line[1]:
                 p.append(f"{where}: 'line' joins point '{line[0]}' to itself")
-            elif length is None or not _is_number(length) or length <= 0:
-                p.append(f"{where}: length must be a positive number, got {length!r}")
+                unplaced.add(line[0])
             else:
-                local[line[0]] = (0.0, 0.0)
-                local[line[1]] = (float(length), 0.0)
+                value = check_number(length, where, "length", p, "positive", "m")
+                if value is None:
+                    unplaced.update(line)
+                else:
+                    local[line[0]] = (0.0, 0.0)
+                    local[line[1]] = (value, 0.0)
         for pname, spec in (points or {}).items():
             pwhere = f"{where} point '{pname}'"
             if pname in local:
                 p.append(f"{pwhere}: declared twice")
                 continue
-            vec = _vector(spec)
-            if vec is None and isinstance(spec, Mapping):
-                vec = self._relative_point(spec, local, pwhere)
-            elif vec is None:
-                p.append(f"{pwhere}: expected [x, y] or {{from, distance, angle_deg}}, got {spec!r}")
-            if vec is not None:
+            if isinstance(spec, Mapping):
+                vec = self._relative_point(spec, local, unplaced, pwhere)
+            else:
+                vec = _coordinates(spec, pwhere, "[x, y] or {from, distance, angle_deg}", p)
+            if vec is None:
+                unplaced.add(pname)
+            else:
                 local[pname] = vec
         link_guides: dict[str, Guide] = {}
         for gname, spec in (guides or {}).items():
             gwhere = f"{where} guide '{gname}'"
-            if not isinstance(spec, Mapping):
-                p.append(f"{gwhere}: expected {{through, angle_deg, offset}}, got {spec!r}")
-                continue
-            unknown = set(spec) - {"through", "angle", "angle_deg", "offset"}
-            if unknown:
-                p.append(f"{gwhere}: unknown keys {sorted(unknown)}")
-            through = spec.get("through", (0.0, 0.0))
-            base = local.get(through) if isinstance(through, str) else _vector(through)
-            if base is None:
-                p.append(f"{gwhere}: 'through' must be a point of the link or [x, y], got {through!r}")
-                continue
-            angle = _angle(spec, "angle", gwhere, p)
-            offset = spec.get("offset", 0.0)
-            if not _is_number(offset):
-                p.append(f"{gwhere}: offset must be a number, got {offset!r}")
-                offset = 0.0
-            nx_, ny_ = -math.sin(angle), math.cos(angle)
-            link_guides[gname] = Guide((base[0] + offset * nx_, base[1] + offset * ny_), angle)
-        for label, value in (("mass", mass), ("inertia", inertia)):
-            if value is not None and (not _is_number(value) or value < 0):
-                p.append(f"{where}: {label} must be a number >= 0, got {value!r}")
-        center: Vec = (0.0, 0.0)
-        if com is not None:
-            center_or_none = local.get(com) if isinstance(com, str) else _vector(com)
-            if center_or_none is None:
-                p.append(f"{where}: centre of mass must be a point of the link or [x, y], got {com!r}")
+            guide = self._guide(spec, local, unplaced, gwhere)
+            if guide is None:
+                unplaced.add(gname)
             else:
-                center = center_or_none
-        elif mass and _is_number(mass) and mass > 0:
+                link_guides[gname] = guide
+        ok_mass = mass is None or check_number(mass, where, "mass", p, "nonnegative", "kg") is not None
+        ok_inertia = inertia is None or check_number(inertia, where, "inertia", p, "nonnegative",
+                                                     "kg m^2") is not None
+        center: Vec = (0.0, 0.0)
+        if isinstance(com, str):
+            if com in local:
+                center = local[com]
+            elif com not in unplaced:
+                p.append(f"{where}: centre of mass must be a point of the link or [x, y], got {com!r}")
+        elif com is not None:
+            center = _coordinates(com, where + " centre of mass", "a point of the link or [x, y]", p) or center
+        elif ok_mass and mass:
             p.append(f"{where}: mass {mass} kg is given without a centre of mass ('com')")
-        ok_mass = mass is not None and _is_number(mass) and mass >= 0
-        ok_inertia = inertia is not None and _is_number(inertia) and inertia >= 0
         self._links[name] = Link(
             name,
             local,
             link_guides,
-            float(mass) if ok_mass else 0.0,
+            float(mass) if mass is not None and ok_mass else 0.0,
             center,
-            float(inertia) if ok_inertia else 0.0,
+            float(inertia) if inertia is not None and ok_inertia else 0.0,
             mass is not None,
         )
         return self
 
-    def _relative_point(self, spec: Mapping[str, Any], local: dict[str, Vec], where: str) -> Vec | None:
+    def _relative_point(self, spec: Mapping[str, Any], local: dict[str, Vec], unplaced: set[str],
+                        where: str) -> Vec | None:
         p = self._problems
-        unknown = set(spec) - {"from", "distance", "angle", "angle_deg"}
-        if unknown:
-            p.append(f"{where}: unknown keys {sorted(unknown)}")
+        unknown_keys(spec, {"from", "distance", "angle", "angle_deg"}, where, p)
         origin = spec.get("from")
-        if origin not in local:
-            p.append(f"{where}: 'from' must name an earlier point of the link, got {origin!r}")
+        if not isinstance(origin, str) or origin not in local:
+            if origin not in unplaced if isinstance(origin, str) else True:
+                p.append(f"{where}: 'from' must name an earlier point of the link, got {origin!r}")
             return None
-        distance = spec.get("distance")
-        if not _is_number(distance) or distance < 0:
-            p.append(f"{where}: distance must be a number >= 0, got {distance!r}")
-            return None
+        distance = check_number(spec.get("distance"), where, "distance", p, "nonnegative", "m")
         angle = _angle(spec, "angle", where, p)
+        if distance is None:
+            return None
         ox, oy = local[origin]
         return (ox + distance * math.cos(angle), oy + distance * math.sin(angle))
+
+    def _guide(self, spec: Any, local: dict[str, Vec], unplaced: set[str], where: str) -> Guide | None:
+        p = self._problems
+        if not isinstance(spec, Mapping):
+            p.append(f"{where}: expected {{through, angle_deg, offset}}, got {spec!r}")
+            return None
+        unknown_keys(spec, {"through", "angle", "angle_deg", "offset"}, where, p)
+        through = spec.get("through", (0.0, 0.0))
+        if isinstance(through, str):
+            base = local.get(through)
+            if base is None and through not in unplaced:
+                p.append(f"{where}: 'through' must be a point of the link or [x, y], got {through!r}")
+        else:
+            base = _coordinates(through, where, "'through' = a point of the link or [x, y]", p)
+        angle = _angle(spec, "angle", where, p)
+        offset = check_number(spec.get("offset", 0.0), where, "offset", p, "real", "m")
+        if base is None or offset is None:
+            return None
+        nx_, ny_ = -math.sin(angle), math.cos(angle)
+        return Guide((base[0] + offset * nx_, base[1] + offset * ny_), angle)
 
     # -- pairs ---------------------------------------------------------------------------------
     def revolute(self, name: str, link_a: str, link_b: str, at: str | None = None) -> "MechanismBuilder":
