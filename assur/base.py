@@ -327,6 +327,11 @@ class Group(ABC):
     def _position(self, poses: Poses, branch: int):
         """Hook: ``(new_poses, assembled)`` in closed form (see the module docstring)."""
 
+    def assembly_failure(self, poses: Poses) -> str | None:
+        """Hook: the dimensional reason why the group assembles at none of the known ``poses``
+        (e.g. ``"|AC| >= 2.1 m but AB + CB = 2 m"``), or None when there is none to tell."""
+        return None
+
     # -- the constraint system -----------------------------------------------------------------
     def residual(self, poses: Poses) -> np.ndarray:
         """Stacked constraint residuals ``(N, 2 * n_joints)`` (prismatic angle rows scaled to m)."""

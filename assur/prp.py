@@ -38,3 +38,7 @@ class PRP(Dyad):
             l1: self.place_by_point_and_angle(B, b1_loc, thetas[0]),
             l2: self.place_by_point_and_angle(B, b2_loc, thetas[1]),
         }, ok
+
+    def assembly_failure(self, poses):
+        first, second = self.ext1.name, self.ext2.name
+        return f"the guides of pairs '{first}' and '{second}' are parallel at every angle"

@@ -44,3 +44,7 @@ class RPP(Dyad):
             l1: self.place_by_point_and_angle(A, a_loc, theta1),
             l2: np.column_stack([origin, theta2]),
         }, ok
+
+    def assembly_failure(self, poses):
+        first, second = self.inner.name, self.ext2.name
+        return f"the guides of pairs '{first}' and '{second}' are parallel at every angle"

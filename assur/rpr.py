@@ -48,3 +48,15 @@ class RPR(Dyad):
             l1: self.place_by_point_and_angle(A, a_loc, theta1),
             l2: self.place_by_point_and_angle(C, c_loc, theta2),
         }, ok
+
+    def assembly_failure(self, poses):
+        l1, l2 = self.links
+        slot = self.inner
+        normal = np.array([-slot.u[1], slot.u[0]])
+        w = rotate(np.array([slot.beta]), np.subtract(slot.p, self.ext1.local(l1)[0]))[0]
+        e = abs(normal @ (np.subtract(slot.g, self.ext2.local(l2)[0]) - w))
+        d = np.linalg.norm(self.known_point(poses, self.ext1, l1) - self.known_point(poses, self.ext2, l2), axis=1)
+        if np.max(d) < e:
+            return (f"|{self.ext1.name}{self.ext2.name}| <= {np.max(d):.6g} m at every angle but the "
+                    f"slot '{slot.name}' runs {e:.6g} m from {self.ext2.name}")
+        return None

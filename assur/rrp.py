@@ -43,3 +43,19 @@ class RRP(Dyad):
             l1: self.place_by_two_points(A, B, a_loc, b1_loc),
             l2: self.place_by_point_and_angle(B, b2_loc, theta2),
         }, ok
+
+    def assembly_failure(self, poses):
+        l1, l2 = self.links
+        guide = self.ext2
+        a_loc, b1_loc = self.ext1.local(l1)[0], self.inner.local(l1)[0]
+        A = self.known_point(poses, self.ext1, l1)
+        G, u = self.guide_line(poses, guide)
+        theta2 = poses[guide.a][:, 2] + guide.beta
+        G_B = G + rotate(theta2, np.subtract(self.inner.local(l2)[0], guide.p))
+        h = np.abs(dot(perp(u), A - G_B))
+        length = np.hypot(*np.subtract(b1_loc, a_loc))
+        if np.min(h) > length:
+            return (f"{self.ext1.name} stays at least {np.min(h):.6g} m from the line of "
+                    f"{self.inner.name} on guide '{guide.name}', but the link {self.ext1.name}"
+                    f"{self.inner.name} is {length:.6g} m long")
+        return None

@@ -44,3 +44,17 @@ class RRR(Dyad):
             l1: self.place_by_two_points(A, B, a_loc, b1_loc),
             l2: self.place_by_two_points(C, B, c_loc, b2_loc),
         }, ok
+
+    def assembly_failure(self, poses):
+        l1, l2 = self.links
+        a, c, b = self.ext1.name, self.ext2.name, self.inner.name
+        d = np.linalg.norm(self.known_point(poses, self.ext2, l2) - self.known_point(poses, self.ext1, l1), axis=1)
+        len1 = np.hypot(*np.subtract(self.inner.local(l1)[0], self.ext1.local(l1)[0]))
+        len2 = np.hypot(*np.subtract(self.inner.local(l2)[0], self.ext2.local(l2)[0]))
+        if np.min(d) > len1 + len2:
+            return (f"|{a}{c}| >= {np.min(d):.6g} m at every angle but {a}{b} + {c}{b} = "
+                    f"{len1 + len2:.6g} m")
+        if np.max(d) < abs(len1 - len2):
+            return (f"|{a}{c}| <= {np.max(d):.6g} m at every angle but |{a}{b} - {c}{b}| = "
+                    f"{abs(len1 - len2):.6g} m")
+        return None

@@ -23,14 +23,12 @@ from numpy.typing import ArrayLike
 
 from assur.base import CANNOT_ASSEMBLE, OK, SINGULAR, global_point, perp, point_analogs, rotate
 
-from .errors import AssemblyError, SchemeError, StructureError
+from .assembly import assembly_branches, assembly_plans, place_group
+from .errors import AssemblyError, StructureError
 from .model import Mechanism, Prismatic
 from .structure import Structure, decompose
 
 __all__ = ["Motion", "analyze", "structure_of", "assembly_branches", "BranchWarning", "parse_quantity"]
-
-#: number of input angles of the sweep that resolves readable assembly conditions into branches
-BRANCH_SWEEP = 360
 
 
 class BranchWarning(UserWarning):
@@ -254,7 +252,7 @@ def analyze(
     phi = np.atleast_1d(np.asarray(phi, dtype=float))
     if phi.ndim != 1 or not np.all(np.isfinite(phi)):
         raise ValueError("phi must be a finite scalar or 1-D array of angles in rad")
-    branches = assembly_branches(mech)
+    plans = assembly_plans(mech)
     group_ids = range(len(structure.groups)) if outputs is None else \
         structure.needed_groups(_links_of(mech, outputs))
     poses, first, second = _input_state(mech, structure, phi, order)
@@ -264,12 +262,14 @@ def analyze(
     for i in group_ids:
         group = structure.groups[i]
         incoming = np.max([error[k] for k in group.known_links], axis=0)
-        placed = group.position(poses, branches[i], incoming)
+        branches = plans[i].branches(phi)
+        placed = place_group(group, poses, branches, incoming)
         poses.update(placed.poses)
         error.update({link: placed.error_bound for link in group.links})
         conditioning[repr(group)] = placed.conditioning
         status = np.where(status == OK, placed.status, status)
-        _check_continuity(group, placed, phi)
+        _check_continuity(group, placed, branches, phi)
+        _check_change_points(group, plans[i], phi)
         if order >= 1:
             d1, d2 = group.analogs(poses, first, second, valid=placed.status == OK)
             first.update(d1)
@@ -336,96 +336,36 @@ def _failure_message(mech: Mechanism, phi: np.ndarray, status: np.ndarray) -> st
             + " (use on_failure='mask' to get a per-position status instead)")
 
 
-def _check_continuity(group, placed, phi) -> None:
-    """Warn when the sign of the group Jacobian's determinant differs between positions."""
-    signs = placed.jacobian_sign[placed.status == OK]
+def _check_continuity(group, placed, branches, phi) -> None:
+    """Warn when the group's Jacobian determinant changes sign (relative to the branch in use)
+    between positions: the group passes a singular position between analysed angles."""
+    ok = placed.status == OK
+    signs = (placed.jacobian_sign * branches)[ok]
     if len(signs) and np.any(signs != signs[0]):
-        changed = np.degrees(phi[(placed.status == OK) & (placed.jacobian_sign != signs[0])])
+        changed = np.degrees(phi[ok][signs != signs[0]])
         warnings.warn(
             f"group {group!r} is in another assembly mode at input angles (deg) "
             f"{np.array2string(changed[:10], precision=4)}: it passes a singular position between "
             "analysed angles", BranchWarning, stacklevel=3)
 
 
-# ----------------------------------------------------------------------------------------------
-# assembly branches from readable conditions
-# ----------------------------------------------------------------------------------------------
-
-
-def assembly_branches(mech: Mechanism) -> tuple[int, ...]:
-    """The branch sign of every group, resolved from the mechanism's assembly conditions.
-
-    A condition such as "B lies left of the line A -> C" is evaluated on both closed-form
-    branches over a sweep of input angles; the branch that satisfies it at more positions wins.
-    """
-    cache = _cache(mech)
-    if "branches" in cache:
-        return cache["branches"]
-    structure = structure_of(mech)
-    rules = _rules_per_group(mech, structure)
-    phi = np.linspace(0.0, 2 * np.pi, BRANCH_SWEEP, endpoint=False)
-    poses, _, _ = _input_state(mech, structure, phi, 0)
-    branches = []
-    for i, group in enumerate(structure.groups):
-        rule = rules.get(i)
-        if rule is None:
-            chosen = 1
-        elif rule.rule == "branch":
-            chosen = rule.value
-        else:
-            votes = {}
-            for m in group.branches:
-                trial = {**poses, **group.position(poses, m).poses}
-                votes[m] = int(np.sum(_rule_score(mech, rule, trial) > 0))
-            if votes[1] == votes[-1]:
-                raise SchemeError(
-                    f"mechanism '{mech.name}': assembly of point '{rule.point}' ({rule.rule} "
-                    f"{list(rule.refs)}) does not tell the two branches of {group!r} apart "
-                    f"(each satisfies it at {votes[1]} of {BRANCH_SWEEP} input angles)")
-            chosen = max(votes, key=votes.get)
-        branches.append(chosen)
-        poses.update(group.position(poses, chosen).poses)
-    cache["branches"] = tuple(branches)
-    return cache["branches"]
-
-
-def _rules_per_group(mech: Mechanism, structure: Structure) -> dict:
-    rules: dict[int, object] = {}
-    problems = []
-    for rule in mech.assembly:
-        owners = [i for i, g in enumerate(structure.groups)
-                  if len(g.branches) > 1 and any(rule.point in mech.links[k].points for k in g.links)]
-        if not owners:
-            problems.append(f"assembly of point '{rule.point}': no group with two assembly branches "
-                            "places this point")
-        elif owners[0] in rules:
-            problems.append(f"assembly of point '{rule.point}': group {structure.groups[owners[0]]!r} "
-                            f"already has the condition on point '{rules[owners[0]].point}'")
-        else:
-            rules[owners[0]] = rule
-    for i, g in enumerate(structure.groups):
-        if len(g.branches) > 1 and i not in rules:
-            pts = sorted({p for k in g.links for p in mech.links[k].points})
-            problems.append(f"group {g!r} has two assembly branches: declare which one with an "
-                            f"assembly condition on one of its points {pts}")
-    if problems:
-        raise SchemeError([f"mechanism '{mech.name}': {p}" for p in problems])
-    return rules
-
-
-def _rule_score(mech: Mechanism, rule, poses) -> np.ndarray:
-    """Positive where the condition holds (NaN where a point is not placed)."""
-
-    def at(point):
-        for link in mech.point_links(point):
-            if link in poses:
-                return global_point(poses[link], mech.links[link].points[point])
-        raise SchemeError(f"assembly of point '{rule.point}': point '{point}' is not placed yet")
-
-    P = at(rule.point)
-    if rule.rule in ("left_of", "right_of"):
-        X, Y = at(rule.refs[0]), at(rule.refs[1])
-        side = (Y - X)[:, 0] * (P - X)[:, 1] - (Y - X)[:, 1] * (P - X)[:, 0]
-        return side if rule.rule == "left_of" else -side
-    X = at(rule.refs[0])
-    return (P - X) @ np.array([np.cos(rule.angle), np.sin(rule.angle)])
+def _check_change_points(group, plan, phi) -> None:
+    """Warn when the analysed angles pass a change point that the group keeps its branch through,
+    or when a followed motion needs two turns to repeat and a whole turn is analysed."""
+    if len(phi) < 2 or not len(plan.change_points):
+        return
+    if plan.mode == "keep":
+        lo, hi = np.minimum(phi[:-1], phi[1:]), np.maximum(phi[:-1], phi[1:])
+        passed = [c for c in plan.change_points
+                  if np.any(np.floor((hi - c) / (2 * np.pi)) > np.floor((lo - c) / (2 * np.pi)))]
+        if passed:
+            shown = ", ".join(f"{round(float(np.degrees(c)), 6) % 360 + 0.0:g}" for c in passed)
+            warnings.warn(
+                f"group {group!r} passes a change point at input angle(s) {shown} deg, where its two "
+                "assembly modes meet; keeping its declared branch it switches assembly mode there "
+                "(declare mode = \"follow\" in its assembly condition to follow the motion through "
+                "it)", BranchWarning, stacklevel=3)
+    elif not plan.closes and np.ptp(phi) >= 2 * np.pi * (1 - 1e-9):
+        warnings.warn(
+            f"group {group!r}, followed through {int(np.sum(plan.swaps))} change point(s) per turn, "
+            "repeats its motion only after two turns of the input", BranchWarning, stacklevel=3)

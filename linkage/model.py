@@ -151,6 +151,14 @@ class Assembly:
     - ``"towards"``: ``point`` lies from ``refs[0]`` in the direction ``angle`` (rad), i.e.
       ``(P - X) . (cos angle, sin angle) > 0``;
     - ``"branch"``: the raw branch sign ``M = value`` of the group's solver (documented per kind).
+
+    ``phi`` (rad), when given, is the input angle at which the condition holds; otherwise it
+    holds at most input angles of a turn.
+
+    ``mode`` says what happens where the group's two assembly modes meet (a change point, where
+    the group passes a singular position and may go on in either mode): ``"keep"`` keeps the
+    declared branch of the closed form (the mechanism switches mode there, with a
+    ``BranchWarning``); ``"follow"`` follows the motion continuously through it.
     """
 
     point: str
@@ -158,6 +166,8 @@ class Assembly:
     refs: tuple[str, ...] = ()
     angle: float = 0.0
     value: int = 1
+    mode: str = "keep"
+    phi: float | None = None
 
 
 @dataclass(frozen=True)
@@ -318,34 +328,33 @@ def check_number(value: Any, where: str, what: str, problems: list[str], kind: s
     test, description = _RANGES[kind]
     if _is_number(value) and test(value):
         return float(value)
-    problems.append(f"{where}: {what} must be {description}{' ' + unit if unit else ''}, got {value!r}")
+    problems.append(f"{where + ': ' if where else ''}{what} must be {description}{' ' + unit if unit else ''}, got {value!r}")
     return None
 
 
-def unknown_keys(spec: Mapping[str, Any], known, where: str, problems: list[str]) -> bool:
+def unknown_keys(spec: Mapping[str, Any], known, where: str, problems: list[str]) -> set[str]:
     """Report the keys of ``spec`` that are not in ``known``, suggesting the known key meant.
 
-    Returns True when an unknown key looks like a misspelling of a known key that ``spec`` lacks
-    (``link`` for ``links``): the entry is then incomplete, and the caller skips it instead of
-    reporting the missing key as a second problem of the same cause.
+    Returns the known keys that ``spec`` lacks and that an unknown key looks like a misspelling
+    of (``{"links"}`` for ``link``): the entry is then incomplete, and the caller may skip it
+    instead of reporting the missing key as a second problem of the same cause.
 
     Examples
     --------
     >>> problems = []
     >>> unknown_keys({"link": ["1", "2"]}, {"links", "kind", "at"}, "pairs.A", problems)
-    True
+    {'links'}
     >>> problems
     ["pairs.A: unknown keys ['link'] (known: ['at', 'kind', 'links']); did you mean 'links'?"]
     """
     bad = sorted(k for k in spec if k not in known)
     if not bad:
-        return False
+        return set()
     absent = sorted(k for k in known if k not in spec)
-    meant = {k: difflib.get_close_matches(str(k), absent, n=1, cutoff=0.75) for k in bad}
-    hints = [f"'{m[0]}'" for m in meant.values() if m]
-    hint = f"; did you mean {', '.join(hints)}?" if hints else ""
-    problems.append(f"{where}: unknown keys {bad} (known: {sorted(known)}){hint}")
-    return bool(hints)
+    meant = [m[0] for m in (difflib.get_close_matches(str(k), absent, n=1, cutoff=0.75) for k in bad) if m]
+    hint = f"; did you mean {', '.join(repr(m) for m in meant)}?" if meant else ""
+    problems.append(f"{where + ': ' if where else ''}unknown keys {bad} (known: {sorted(known)}){hint}")
+    return set(meant)
 
 
 def _angle(spec: Mapping[str, Any], key: str, where: str, problems: list[str], default=0.0):
@@ -446,7 +455,7 @@ class MechanismBuilder:
         local: dict[str, Vec] = {}
         unplaced = self._unplaced.setdefault(name, set())  # declared, but refused: no follow-ons
         if line is not None or length is not None:
-            if line is None or len(line) != 2 or not all(isinstance(s, str) for s in line):
+            if not isinstance(line, (tuple, list)) or len(line) != 2 or not all(isinstance(s, str) for s in line):
                 p.append(f"{where}: 'line' must name two points, got {line!r}")
             elif line[0] == line[1]:
                 p.append(f"{where}: 'line' joins point '{line[0]}' to itself")
@@ -509,7 +518,7 @@ class MechanismBuilder:
         unknown_keys(spec, {"from", "distance", "angle", "angle_deg"}, where, p)
         origin = spec.get("from")
         if not isinstance(origin, str) or origin not in local:
-            if origin not in unplaced if isinstance(origin, str) else True:
+            if not (isinstance(origin, str) and origin in unplaced):  # else: reported already
                 p.append(f"{where}: 'from' must name an earlier point of the link, got {origin!r}")
             return None
         distance = check_number(spec.get("distance"), where, "distance", p, "nonnegative", "m")
@@ -553,8 +562,23 @@ class MechanismBuilder:
 
         ``angle`` is the fixed angle of the slider's x axis to the guide direction (rad).
         """
-        if self._check_pair_name(name):
-            self._pairs[name] = Prismatic(name, (guide_link, slider_link), guide, at, float(angle))
+        value = check_number(angle, f"pair '{name}'", "angle", self._problems, "angle", "rad")
+        if value is None:
+            self._rejected.add(name)
+        elif self._check_pair_name(name):
+            self._pairs[name] = Prismatic(name, (guide_link, slider_link), guide, at, value)
+        return self
+
+    def reject(self, name: str, names=()) -> "MechanismBuilder":
+        """Note that the declaration of the link or pair ``name`` was refused by the caller, who
+        has reported why (a misspelt key in a scheme file, say).
+
+        :meth:`build` then leaves out the problems that only follow from its absence (pairs that
+        join it, the points and guides ``names`` it declares, the input's frame pair): one message
+        per root cause.
+        """
+        self._rejected.add(name)
+        self._unplaced.setdefault(name, set()).update(n for n in names if isinstance(n, str))
         return self
 
     def _check_pair_name(self, name: str) -> bool:
@@ -578,14 +602,27 @@ class MechanismBuilder:
         towards: float | None = None,
         origin: str | None = None,
         branch: int | None = None,
+        mode: str = "keep",
+        phi: float | None = None,
     ) -> "MechanismBuilder":
         """Pick the assembly branch of the group that places ``point``.
 
         Exactly one of: ``left_of=(X, Y)`` / ``right_of=(X, Y)`` (the point lies left / right of
         the directed line X -> Y); ``towards=angle`` with ``origin=X`` (the point lies from X in
         that direction, rad); ``branch=+1/-1`` (the solver's raw sign, see its kind).
+        ``mode``: ``"keep"`` (default) keeps that branch through change points, ``"follow"``
+        follows the motion continuously through them (see :class:`Assembly`). ``phi`` (rad):
+        the input angle at which the condition holds (default: at most angles of a turn).
         """
         where = f"assembly of point '{point}'"
+        if mode not in ("keep", "follow"):
+            self._problems.append(f"{where}: mode must be 'keep' or 'follow', got {mode!r}")
+            return self
+        if phi is not None and not (_is_number(phi) and math.isfinite(phi)):
+            self._problems.append(f"{where}: the input angle of the condition must be a finite number, "
+                                  f"got {phi!r}")
+            return self
+        extra = {"mode": mode, "phi": None if phi is None else float(phi)}
         given = [k for k, v in (("left_of", left_of), ("right_of", right_of), ("towards", towards),
                                 ("branch", branch)) if v is not None]
         if len(given) != 1:
@@ -597,17 +634,17 @@ class MechanismBuilder:
             if not (isinstance(refs, (list, tuple)) and len(refs) == 2):
                 self._problems.append(f"{where}: {given[0]} must name two points, got {refs!r}")
                 return self
-            self._assembly.append(Assembly(point, given[0], tuple(refs)))
+            self._assembly.append(Assembly(point, given[0], tuple(refs), **extra))
         elif towards is not None:
             if origin is None or not _is_number(towards):
                 self._problems.append(f"{where}: 'towards' needs an angle and 'from' a point")
                 return self
-            self._assembly.append(Assembly(point, "towards", (origin,), float(towards)))
+            self._assembly.append(Assembly(point, "towards", (origin,), float(towards), **extra))
         else:
             if branch not in (1, -1):
                 self._problems.append(f"{where}: branch must be +1 or -1, got {branch!r}")
                 return self
-            self._assembly.append(Assembly(point, "branch", value=int(branch)))
+            self._assembly.append(Assembly(point, "branch", value=int(branch), **extra))
         return self
 
     def output(self, quantity: str, start: str = "max") -> "MechanismBuilder":
@@ -630,22 +667,38 @@ class MechanismBuilder:
             self.description,
             dict(extra),
         )
-        problems = self._problems + validate(mech)
+        problems = self._problems + validate(mech, self._rejected, self._unplaced)
         if problems:
             raise SchemeError(problems)
         return mech
 
 
-def validate(mech: Mechanism) -> list[str]:
-    """Every problem of a mechanism's declaration (empty when it is sound)."""
+def validate(mech: Mechanism, rejected=frozenset(), unplaced: Mapping[str, set] | None = None) -> list[str]:
+    """Every problem of a mechanism's declaration (empty when it is sound).
+
+    Parameters
+    ----------
+    mech : Mechanism
+    rejected : set of str
+        Links and pairs whose declarations were refused (already reported): problems that only
+        follow from their absence are left out.
+    unplaced : dict of link -> set of str
+        Points and guides of a link whose declarations were refused (already reported).
+    """
     p: list[str] = []
     links = mech.links
+    unplaced = unplaced or {}
+
+    def refused(link: str, name: str) -> bool:
+        return link in rejected or name in unplaced.get(link, ())
+
     for pair in mech.pairs.values():
         where = f"pair '{pair.name}'"
         a, b = pair.links
         bad = [x for x in (a, b) if x not in links]
         for x in bad:
-            p.append(f"{where}: joins unknown link '{x}'")
+            if x not in rejected:
+                p.append(f"{where}: joins unknown link '{x}'")
         if bad:
             continue
         if a == b:
@@ -653,13 +706,13 @@ def validate(mech: Mechanism) -> list[str]:
             continue
         if isinstance(pair, Revolute):
             for x in (a, b):
-                if pair.point not in links[x].points:
+                if pair.point not in links[x].points and not refused(x, pair.point):
                     p.append(f"{where}: point '{pair.point}' is not declared on link '{x}'")
         else:
-            if pair.guide not in links[a].guides:
+            if pair.guide not in links[a].guides and not refused(a, pair.guide):
                 p.append(f"{where}: link '{a}' has no guide '{pair.guide}' "
                          f"(it has {sorted(links[a].guides) or 'none'})")
-            if pair.point not in links[b].points:
+            if pair.point not in links[b].points and not refused(b, pair.point):
                 p.append(f"{where}: point '{pair.point}' is not declared on slider link '{b}'")
     clash = sorted(set(mech.pairs) & set(links))
     for name in clash:
@@ -670,23 +723,27 @@ def validate(mech: Mechanism) -> list[str]:
         p.append(f"input links declared twice: {list(mech.inputs)}")
     for name in mech.inputs:
         if name not in links:
-            p.append(f"input link '{name}' is not a declared link")
+            if name not in rejected:
+                p.append(f"input link '{name}' is not a declared link")
         elif name == mech.frame:
             p.append(f"input link '{name}' is the frame")
-        elif not any(isinstance(pr, Revolute) and set(pr.links) == {name, mech.frame}
-                     for pr in mech.pairs.values()):
+        elif not rejected and not any(isinstance(pr, Revolute) and set(pr.links) == {name, mech.frame}
+                                      for pr in mech.pairs.values()):
             p.append(f"input link '{name}' is not pinned to the frame '{mech.frame}' by a revolute pair")
     known_points = {q for lk in links.values() for q in lk.points}
+    refused_points = {q for names in unplaced.values() for q in names}
     for rule in mech.assembly:
         for q in (rule.point, *rule.refs):
-            if q not in known_points:
+            if not isinstance(q, str) or (q not in known_points and q not in refused_points):
                 p.append(f"assembly of point '{rule.point}': unknown point '{q}'")
     if mech.output is not None:
-        p.extend(_output_problems(mech))
+        p.extend(_output_problems(mech, refused=set(rejected) | refused_points))
     return p
 
 
-def _output_problems(mech: Mechanism) -> list[str]:
+def _output_problems(mech: Mechanism, refused=frozenset()) -> list[str]:
+    """Problems of the declared output; a quantity that names a ``refused`` point, link or pair is
+    not reported (its declaration's problem is)."""
     out = mech.output
     where = f"output '{out.quantity}'"
     problems = []
@@ -699,7 +756,7 @@ def _output_problems(mech: Mechanism) -> list[str]:
         or (coord == "theta" and name in mech.links and name != mech.frame)
         or (coord == "s" and isinstance(mech.pairs.get(name), Prismatic))
     )
-    if not ok:
+    if not ok and name not in refused:
         problems.append(f"{where}: expected 'P.x', 'P.y' (point), 'L.theta' (moving link) or "
                         f"'K.s' (prismatic pair)")
     return problems

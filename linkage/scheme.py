@@ -19,18 +19,82 @@ from pathlib import Path
 from typing import Any, Callable, Mapping
 
 from .errors import SchemeError, StructureError
-from .model import Mechanism, MechanismBuilder, Prismatic, Revolute, _is_number
+from .model import Mechanism, MechanismBuilder, Prismatic, Revolute, _angle, _is_number, unknown_keys
 
-__all__ = ["load", "loads", "dumps", "save", "shipped_schemes", "scheme_path", "SECTION_VALIDATORS"]
+__all__ = ["load", "loads", "dumps", "save", "shipped_schemes", "scheme_path", "section_of",
+           "register_section", "SECTION_PARSERS"]
 
 TOP_KEYS = {"name", "description", "frame", "input", "inputs", "output", "links", "pairs", "assembly"}
 LINK_KEYS = {"line", "length", "points", "guides", "mass", "com", "inertia"}
 PAIR_KEYS = {"kind", "links", "at", "guide", "angle", "angle_deg"}
+#: keys of a link that place its points or guides (or its centre of mass, which its mass needs):
+#: a link that misspells one of them is incomplete
+LINK_GEOMETRY = {"line", "length", "points", "guides", "com"}
 PAIR_KINDS = {"R": "R", "revolute": "R", "P": "P", "prismatic": "P"}
 
-#: Further top-level sections (``loads``, ``dynamics`` ...): name -> validator returning a list of
-#: problems for (mechanism, raw section). Registered by the modules that use them.
-SECTION_VALIDATORS: dict[str, Callable[[Mechanism, Any], list[str]]] = {}
+#: Further top-level sections (``loads``, ``dynamics`` ...): name -> parser
+#: ``(mechanism, raw section or None) -> (typed part, problems)``. Registered by the modules that
+#: own them; a scheme's sections are parsed once, when it is loaded (see :func:`section_of`).
+SECTION_PARSERS: dict[str, Callable[[Mechanism, Any], tuple[Any, list[str]]]] = {}
+#: section -> the sections its parser reads (``loads`` reads the cycle of ``dynamics``)
+_REQUIRES: dict[str, tuple[str, ...]] = {}
+
+
+def register_section(name: str, parser: Callable[[Mechanism, Any], tuple[Any, list[str]]],
+                     requires: tuple[str, ...] = ()) -> None:
+    """Register the parser of a further top-level section ``name``.
+
+    Parameters
+    ----------
+    name : str
+        The section (``"loads"``).
+    parser : callable
+        ``parser(mech, raw) -> (typed part, problems)``; ``raw`` is None when the scheme has no
+        such section. It may read the typed parts it ``requires`` with :func:`section_of`.
+    requires : tuple of str
+        Sections parsed before this one.
+    """
+    SECTION_PARSERS[name] = parser
+    _REQUIRES[name] = tuple(requires)
+
+
+def _section_order() -> list[str]:
+    """Registered sections, each after the sections it requires."""
+    order: list[str] = []
+
+    def visit(name: str) -> None:
+        for dep in _REQUIRES.get(name, ()):
+            visit(dep)
+        if name in SECTION_PARSERS and name not in order:
+            order.append(name)
+
+    for name in SECTION_PARSERS:
+        visit(name)
+    return order
+
+
+def section_of(mech: Mechanism, name: str) -> Any:
+    """The typed part ``name`` of a mechanism (its ``Loads``, its ``DynamicsSpec`` or None).
+
+    Parsed once from ``mech.extra[name]`` and kept in ``mech.parts``: a loaded scheme has every
+    part already; a mechanism built in Python (or by :meth:`Mechanism.with_extra`) has it parsed
+    on first use.
+
+    Raises
+    ------
+    SchemeError
+        When the section is declared wrongly (every problem, naming the mechanism).
+    """
+    parts = mech.parts
+    if name not in parts:
+        for dep in _REQUIRES.get(name, ()):
+            if dep in SECTION_PARSERS:
+                section_of(mech, dep)
+        value, problems = SECTION_PARSERS[name](mech, mech.extra.get(name))
+        if problems:
+            raise SchemeError([f"mechanism '{mech.name}' {name}: {p}" for p in problems])
+        parts[name] = value
+    return parts[name]
 
 
 def _schemes_dirs() -> list[Path]:
@@ -106,32 +170,43 @@ def _context(text: str, message: str) -> str:
 
 
 def from_dict(data: Mapping[str, Any], default_name: str = "mechanism") -> Mechanism:
-    """Build and validate a mechanism from a parsed scheme (structure included)."""
+    """Build and validate a mechanism from a parsed scheme, and parse its further sections once.
+
+    Structure first: the declaration of links, pairs, inputs, assembly and output; then the
+    mobility and the decomposition into groups; then the further sections (``dynamics``,
+    ``loads``), parsed into the mechanism's typed parts (``mech.parts``). Each stage runs only
+    when the one before found no problem, so a problem is reported once, as its root cause, and
+    not through what follows from it.
+
+    Raises
+    ------
+    SchemeError
+        Every problem of the first stage that has any.
+    """
     from .kinematics import assembly_branches, structure_of
 
     problems: list[str] = []
-    extra_sections = {k: v for k, v in data.items() if k in SECTION_VALIDATORS}
-    unknown = set(data) - TOP_KEYS - set(SECTION_VALIDATORS)
-    if unknown:
-        problems.append(f"unknown top-level keys {sorted(unknown)} (known: "
-                        f"{sorted(TOP_KEYS | set(SECTION_VALIDATORS))})")
+    extra_sections = {k: v for k, v in data.items() if k in SECTION_PARSERS}
+    unknown_keys(data, TOP_KEYS | set(SECTION_PARSERS), "top-level", problems)
     name = data.get("name", default_name)
     builder = MechanismBuilder(str(name), str(data.get("description", "")), str(data.get("frame", "0")))
     links = _table(data, "links", problems)
     for lname, spec in links.items():
         if not isinstance(spec, Mapping):
             problems.append(f"links.{lname}: expected a table, got {spec!r}")
+            builder.reject(lname)
             continue
-        bad = set(spec) - LINK_KEYS
-        if bad:
-            problems.append(f"links.{lname}: unknown keys {sorted(bad)} (known: {sorted(LINK_KEYS)})")
+        if unknown_keys(spec, LINK_KEYS, f"links.{lname}", problems) & LINK_GEOMETRY:
+            builder.reject(lname, _declared_names(spec))  # incomplete: say so once, not its follow-ons
+            continue
         line = spec.get("line")
         builder.link(lname, line=tuple(line) if isinstance(line, list) else line, length=spec.get("length"),
                      points=_table(spec, "points", problems, f"links.{lname}"),
                      guides=_table(spec, "guides", problems, f"links.{lname}"),
                      mass=spec.get("mass"), com=_com(spec.get("com")), inertia=spec.get("inertia"))
     for pname, spec in _table(data, "pairs", problems).items():
-        _add_pair(builder, pname, spec, problems, set(links) | {builder.frame})
+        if not _add_pair(builder, pname, spec, problems):
+            builder.reject(pname)
     inputs = data.get("inputs", data.get("input"))
     if isinstance(inputs, str):
         inputs = [inputs]
@@ -146,6 +221,7 @@ def from_dict(data: Mapping[str, Any], default_name: str = "mechanism") -> Mecha
         if isinstance(output, str):
             builder.output(output)
         elif isinstance(output, Mapping) and isinstance(output.get("quantity"), str):
+            unknown_keys(output, {"quantity", "start"}, "output", problems)
             builder.output(output["quantity"], output.get("start", "max"))
         else:
             problems.append(f"output: expected \"P.x\" or {{quantity, start}}, got {output!r}")
@@ -153,8 +229,6 @@ def from_dict(data: Mapping[str, Any], default_name: str = "mechanism") -> Mecha
         mech = builder.build(**extra_sections)
     except SchemeError as exc:
         raise SchemeError(problems + exc.problems) from None
-    for section, raw in extra_sections.items():
-        problems += [f"{section}: {p}" for p in SECTION_VALIDATORS[section](mech, raw)]
     if problems:
         raise SchemeError(problems)
     try:
@@ -162,6 +236,14 @@ def from_dict(data: Mapping[str, Any], default_name: str = "mechanism") -> Mecha
         assembly_branches(mech)
     except StructureError as exc:
         raise SchemeError(str(exc)) from None
+    for section in _section_order():
+        if section not in mech.parts:
+            value, found = SECTION_PARSERS[section](mech, extra_sections.get(section))
+            problems += [f"{section}: {p}" for p in found]
+            if not found:
+                mech.parts[section] = value
+    if problems:
+        raise SchemeError(problems)
     return mech
 
 
@@ -173,41 +255,52 @@ def _table(data, key, problems, where="") -> dict:
     return dict(value)
 
 
+def _declared_names(spec: Mapping[str, Any]) -> list:
+    """The point and guide names a raw link table declares (its line, points and guides)."""
+    names = list(spec.get("line", [])) if isinstance(spec.get("line"), list) else []
+    for key in ("points", "guides"):
+        if isinstance(spec.get(key), Mapping):
+            names += list(spec[key])
+    return names
+
+
 def _com(raw):
     return tuple(raw) if isinstance(raw, list) else raw
 
 
-def _add_pair(builder, name, spec, problems, link_names):
+def _add_pair(builder, name, spec, problems, link_names=None) -> bool:
+    """Declare the pair ``name`` on the builder; False (with the problem) when it is refused."""
     where = f"pairs.{name}"
     if not isinstance(spec, Mapping):
         problems.append(f"{where}: expected a table, got {spec!r}")
-        return
-    bad = set(spec) - PAIR_KEYS
-    if bad:
-        problems.append(f"{where}: unknown keys {sorted(bad)} (known: {sorted(PAIR_KEYS)})")
-    kind = PAIR_KINDS.get(spec.get("kind", "R"))
+        return False
+    if unknown_keys(spec, PAIR_KEYS, where, problems):
+        return False  # a misspelt key: the pair is incomplete, say so once
+    raw_kind = spec.get("kind", "R")
+    kind = PAIR_KINDS.get(raw_kind) if isinstance(raw_kind, str) else None
     links = spec.get("links")
     if kind is None:
-        problems.append(f"{where}: kind must be 'R' (revolute) or 'P' (prismatic), got {spec.get('kind')!r}")
-        return
+        problems.append(f"{where}: kind must be 'R' (revolute) or 'P' (prismatic), got {raw_kind!r}")
+        return False
     if not (isinstance(links, list) and len(links) == 2 and all(isinstance(x, str) for x in links)):
         problems.append(f"{where}: 'links' must name two links, got {links!r}")
-        return
+        return False
+    if "at" in spec and not isinstance(spec["at"], str):
+        problems.append(f"{where}: 'at' must name a point, got {spec['at']!r}")
+        return False
     if kind == "R":
         builder.revolute(name, links[0], links[1], spec.get("at"))
-        return
+        return True
     if not isinstance(spec.get("guide"), str) or not isinstance(spec.get("at"), str):
         problems.append(f"{where}: a prismatic pair needs 'guide' (a guide of link '{links[0]}') and "
                         f"'at' (a point of slider link '{links[1]}')")
-        return
-    angle = 0.0
-    if "angle" in spec or "angle_deg" in spec:
-        raw = spec.get("angle", spec.get("angle_deg"))
-        if not _is_number(raw):
-            problems.append(f"{where}: angle must be a number, got {raw!r}")
-        else:
-            angle = float(raw) if "angle" in spec else math.radians(raw)
+        return False
+    count = len(problems)
+    angle = _angle(spec, "angle", where, problems)
+    if len(problems) > count:
+        return False
     builder.prismatic(name, links[0], links[1], guide=spec["guide"], at=spec["at"], angle=angle)
+    return True
 
 
 def _add_assembly(builder, point, spec, problems):
@@ -215,7 +308,7 @@ def _add_assembly(builder, point, spec, problems):
     if not isinstance(spec, Mapping):
         problems.append(f"{where}: expected a table such as {{left_of = [\"A\", \"C\"]}}, got {spec!r}")
         return
-    known = {"left_of", "right_of", "towards", "towards_deg", "from", "branch"}
+    known = {"left_of", "right_of", "towards", "towards_deg", "from", "branch", "mode", "phi", "phi_deg"}
     bad = set(spec) - known
     if bad:
         problems.append(f"{where}: unknown keys {sorted(bad)} (known: {sorted(known)})")
@@ -223,7 +316,19 @@ def _add_assembly(builder, point, spec, problems):
     if "towards_deg" in spec:
         towards = math.radians(spec["towards_deg"]) if _is_number(spec["towards_deg"]) else spec["towards_deg"]
     builder.assembly(point, left_of=spec.get("left_of"), right_of=spec.get("right_of"),
-                     towards=towards, origin=spec.get("from"), branch=spec.get("branch"))
+                     towards=towards, origin=spec.get("from"), branch=spec.get("branch"),
+                     mode=spec.get("mode", "keep"), phi=_angle_key(spec, "phi", where, problems))
+
+
+def _angle_key(spec, key, where, problems):
+    """The angle given as ``key`` (rad) or ``key_deg`` (deg), in rad; None when absent."""
+    if f"{key}_deg" in spec:
+        raw = spec[f"{key}_deg"]
+        if _is_number(raw):
+            return math.radians(raw)
+        problems.append(f"{where}: {key}_deg must be a number, got {raw!r}")
+        return None
+    return spec.get(key)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -263,11 +368,16 @@ def to_dict(mech: Mechanism) -> dict[str, Any]:
         data["assembly"] = {}
         for rule in mech.assembly:
             if rule.rule == "branch":
-                data["assembly"][rule.point] = {"branch": rule.value}
+                entry = {"branch": rule.value}
             elif rule.rule == "towards":
-                data["assembly"][rule.point] = {"towards": rule.angle, "from": rule.refs[0]}
+                entry = {"towards": rule.angle, "from": rule.refs[0]}
             else:
-                data["assembly"][rule.point] = {rule.rule: list(rule.refs)}
+                entry = {rule.rule: list(rule.refs)}
+            if rule.mode != "keep":
+                entry["mode"] = rule.mode
+            if rule.phi is not None:
+                entry["phi"] = rule.phi
+            data["assembly"][rule.point] = entry
     data.update(copy.deepcopy(dict(mech.extra)))
     return data
 
@@ -306,7 +416,7 @@ def _value(v: Any) -> str:
         return "[" + ", ".join(_value(x) for x in v) + "]"
     if isinstance(v, Mapping):
         return "{" + ", ".join(f"{_key(k)} = {_value(x)}" for k, x in v.items()) + "}"
-    raise TypeError(f"cannot write {v!r} to TOML")
+    raise SchemeError(f"cannot write {v!r} to TOML (only numbers, strings, lists and tables)")
 
 
 def _toml_table(data: Mapping[str, Any], path: tuple[str, ...], array: bool = False) -> str:

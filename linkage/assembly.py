@@ -1,0 +1,311 @@
+"""Assembly modes: which closed-form branch each group takes at each input angle.
+
+A group with two assembly branches (RRR, RRP, RPR) is declared by a readable condition
+(``left_of``, ``towards`` ... see :class:`linkage.model.Assembly`). Where the group passes a
+singular position with both sides assembled -- a *change point*, such as the parallelogram
+four-bar's collinear position or the deltoid's coincident pivots -- its two assembly modes meet
+and the motion may go on in either. This module finds those points once per mechanism, on a
+sweep of the input angle refined by a bounded minimisation of the group's conditioning, and
+decides for each whether the continuous motion changes closed-form branch there (by
+extrapolating the group's poses from one side to the other). A group then either keeps its
+declared branch (``mode = "keep"``, the default: the mechanism switches assembly mode at the
+change point, and ``analyze`` warns when the analysed angles pass one) or follows the motion
+through it (``mode = "follow"``).
+
+>>> import linkage
+>>> plans = assembly_plans(linkage.load("four_bar"))
+>>> plans[0].branch, plans[0].mode, len(plans[0].change_points)
+(1, 'keep', 0)
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import minimize_scalar
+
+from assur.base import Group, GroupPosition, global_point
+
+from .errors import SchemeError
+from .model import Mechanism
+from .structure import Structure
+
+__all__ = ["BranchPlan", "assembly_plans", "assembly_branches", "place_group", "BRANCH_SWEEP"]
+
+#: number of input angles of the sweep that resolves conditions and finds change points
+BRANCH_SWEEP = 360
+#: conditioning below which a local minimum counts as a meeting of the two assembly modes
+CHANGE_POINT_TOL = 1e-6
+#: step (rad) of the poses extrapolated across a change point to tell how the motion goes on
+CROSSING_STEP = 1e-3
+
+TWO_PI = 2 * np.pi
+
+
+@dataclass(frozen=True)
+class BranchPlan:
+    """How one group's closed-form branch is chosen at every input angle.
+
+    Attributes
+    ----------
+    branch : int
+        The declared branch (+1 / -1; for ``"follow"``, the branch from phi = 0 up to the first
+        change point that swaps).
+    mode : {"keep", "follow"}
+        Keep the declared branch everywhere, or follow the motion through change points.
+    change_points : ndarray (K,)
+        Input angles in [0, 2 pi) where the group's two assembly modes meet, rad.
+    swaps : ndarray of bool (K,)
+        Whether the continuous motion changes closed-form branch at each change point.
+    """
+
+    branch: int
+    mode: str
+    change_points: np.ndarray
+    swaps: np.ndarray
+
+    def branches(self, phi: np.ndarray) -> np.ndarray:
+        """Closed-form branch ``(N,)`` at the (unwrapped) input angles ``phi``."""
+        phi = np.asarray(phi, dtype=float)
+        if self.mode == "keep" or not self.swaps.any():
+            return np.full(phi.shape, self.branch, dtype=int)
+        points = np.sort(self.change_points[self.swaps])
+        turns = np.floor(phi / TWO_PI)
+        count = turns.astype(int) * len(points) + np.searchsorted(points, phi - turns * TWO_PI, side="right")
+        return np.where(count % 2 == 0, self.branch, -self.branch)
+
+    @property
+    def closes(self) -> bool:
+        """Whether the followed motion repeats after one turn (an even number of swaps)."""
+        return self.mode == "keep" or int(np.sum(self.swaps)) % 2 == 0
+
+
+def place_group(group: Group, poses, branches: np.ndarray, input_error=0.0) -> GroupPosition:
+    """:meth:`Group.position` with a branch per position (each branch solved where it is used)."""
+    values = np.unique(branches)
+    if len(values) == 1:
+        return group.position(poses, int(values[0]), input_error)
+    parts = {int(b): group.position(poses, int(b), input_error) for b in values}
+
+    def pick(get):
+        out = get(parts[int(values[0])])
+        for b in values[1:]:
+            mask = branches == b
+            out = np.where(mask[:, None] if out.ndim == 2 else mask, get(parts[int(b)]), out)
+        return out
+
+    first = parts[int(values[0])]
+    return GroupPosition({k: pick(lambda p, k=k: p.poses[k]) for k in first.poses},
+                         pick(lambda p: p.status), pick(lambda p: p.jacobian_sign),
+                         pick(lambda p: p.conditioning), pick(lambda p: p.error_bound))
+
+
+# ----------------------------------------------------------------------------------------------
+# resolving the declared conditions
+# ----------------------------------------------------------------------------------------------
+
+
+def assembly_plans(mech: Mechanism) -> tuple[BranchPlan, ...]:
+    """The branch plan of every group of ``mech`` (cached on the mechanism).
+
+    A readable condition is evaluated on both candidate motions over a sweep of input angles;
+    the candidate that satisfies it at more positions wins.
+
+    Raises
+    ------
+    SchemeError
+        When a condition names no suitable point, does not tell the candidates apart, or a
+        group can be assembled at no input angle (the message names the group and the
+        dimensional reason).
+    """
+    from .kinematics import _cache, _input_state, structure_of
+
+    cache = _cache(mech)
+    if "plans" in cache:
+        return cache["plans"]
+    structure = structure_of(mech)
+    rules = _rules_per_group(mech, structure)
+    phi = np.linspace(0.0, TWO_PI, BRANCH_SWEEP, endpoint=False)
+    poses, _, _ = _input_state(mech, structure, phi, 0)
+    plans: list[BranchPlan] = []
+    for i, group in enumerate(structure.groups):
+        rule = rules.get(i)
+        mode = rule.mode if rule is not None else "keep"
+        if len(group.branches) == 1:
+            plan = BranchPlan(1, "keep", np.empty(0), np.empty(0, bool))
+            _require_assembly(mech, group, poses, plan.branches(phi))
+        else:
+            changes, swaps = _change_points(mech, structure, plans, i, phi, poses)
+            candidates = {m: BranchPlan(m, mode, changes, swaps) for m in group.branches}
+            _require_assembly(mech, group, poses, candidates[1].branches(phi))
+            if rule is not None and rule.phi is not None:
+                at = np.array([rule.phi])
+                chosen = _choose(mech, group, rule, candidates, _chain(mech, structure, plans, i, at), at)
+            else:
+                chosen = _choose(mech, group, rule, candidates, poses, phi)
+            plan = candidates[chosen]
+        plans.append(plan)
+        poses.update(place_group(group, poses, plan.branches(phi)).poses)
+    cache["plans"] = tuple(plans)
+    return cache["plans"]
+
+
+def assembly_branches(mech: Mechanism) -> tuple[int, ...]:
+    """The declared branch sign of every group (see :func:`assembly_plans`)."""
+    return tuple(p.branch for p in assembly_plans(mech))
+
+
+def _choose(mech, group, rule, candidates, poses, phi) -> int:
+    if rule.rule == "branch":
+        return rule.value
+    votes = {}
+    for m, plan in candidates.items():
+        trial = {**poses, **place_group(group, poses, plan.branches(phi)).poses}
+        # a point on the reference line (within round-off) satisfies neither side
+        votes[m] = int(np.sum(_rule_score(mech, rule, trial) > 1e-9 * mech.size))
+    if votes[1] == votes[-1]:
+        where = (f"at the input angle {np.degrees(rule.phi):.6g} deg" if rule.phi is not None else
+                 f"(each satisfies it at {votes[1]} of {BRANCH_SWEEP} input angles; give the input "
+                 "angle at which it holds with phi_deg)")
+        raise SchemeError(
+            f"mechanism '{mech.name}': assembly of point '{rule.point}' ({rule.rule} "
+            f"{list(rule.refs)}) does not tell the two branches of {group!r} apart {where}")
+    return max(votes, key=votes.get)
+
+
+def _require_assembly(mech, group, poses, branches) -> None:
+    """SchemeError naming the group and the reason when it assembles at no angle of the sweep."""
+    placed = place_group(group, poses, branches)
+    if np.any(placed.status != -1):
+        return
+    reason = group.assembly_failure(poses)
+    raise SchemeError(
+        f"mechanism '{mech.name}': group {group!r} cannot be assembled at any input angle"
+        + (f": {reason}" if reason else "") + " (check the dimensions of its links)")
+
+
+def _rules_per_group(mech: Mechanism, structure: Structure) -> dict:
+    rules: dict[int, object] = {}
+    problems = []
+    for rule in mech.assembly:
+        owners = [i for i, g in enumerate(structure.groups)
+                  if len(g.branches) > 1 and any(rule.point in mech.links[k].points for k in g.links)]
+        if not owners:
+            problems.append(f"assembly of point '{rule.point}': no group with two assembly branches "
+                            "places this point")
+        elif owners[0] in rules:
+            problems.append(f"assembly of point '{rule.point}': group {structure.groups[owners[0]]!r} "
+                            f"already has the condition on point '{rules[owners[0]].point}'")
+        else:
+            rules[owners[0]] = rule
+    for i, g in enumerate(structure.groups):
+        if len(g.branches) > 1 and i not in rules:
+            pts = sorted({p for k in g.links for p in mech.links[k].points})
+            problems.append(f"group {g!r} has two assembly branches: declare which one with an "
+                            f"assembly condition on one of its points {pts}")
+    if problems:
+        raise SchemeError([f"mechanism '{mech.name}': {p}" for p in problems])
+    return rules
+
+
+def _rule_score(mech: Mechanism, rule, poses) -> np.ndarray:
+    """Signed distance (m), positive where the condition holds (NaN where a point is not placed)."""
+
+    def at(point):
+        for link in mech.point_links(point):
+            if link in poses:
+                return global_point(poses[link], mech.links[link].points[point])
+        raise SchemeError(f"assembly of point '{rule.point}': point '{point}' is not placed yet")
+
+    P = at(rule.point)
+    if rule.rule in ("left_of", "right_of"):
+        X, Y = at(rule.refs[0]), at(rule.refs[1])
+        side = (Y - X)[:, 0] * (P - X)[:, 1] - (Y - X)[:, 1] * (P - X)[:, 0]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            side = side / np.linalg.norm(Y - X, axis=1)
+        return side if rule.rule == "left_of" else -side
+    X = at(rule.refs[0])
+    return (P - X) @ np.array([np.cos(rule.angle), np.sin(rule.angle)])
+
+
+# ----------------------------------------------------------------------------------------------
+# change points
+# ----------------------------------------------------------------------------------------------
+
+
+def _chain(mech, structure, plans, i, phi):
+    """Poses of the known links of group ``i`` at the angles ``phi`` (earlier groups placed)."""
+    from .kinematics import _input_state
+
+    poses, _, _ = _input_state(mech, structure, phi, 0)
+    for j in structure.needed_groups(structure.groups[i].known_links):
+        poses.update(place_group(structure.groups[j], poses, plans[j].branches(phi)).poses)
+    return poses
+
+
+def _change_points(mech, structure, plans, i, phi, poses) -> tuple[np.ndarray, np.ndarray]:
+    """Angles in [0, 2 pi) where group ``i``'s assembly modes meet, and whether the motion swaps
+    closed-form branch there."""
+    group = structure.groups[i]
+    r = group.position(poses, 1).conditioning
+    ok = np.isfinite(r)
+    low = np.where(ok, r, np.inf)
+    before, after = np.roll(low, 1), np.roll(low, -1)
+    # local minima of the conditioning, and single angles where the closed form gives up between
+    # two assembled neighbours (e.g. the deltoid's coincident pivots)
+    cells = np.flatnonzero(np.roll(ok, 1) & np.roll(ok, -1)
+                           & (~ok | (low <= np.minimum(before, after)))
+                           & (np.minimum(low, np.minimum(before, after)) < 0.1))
+    step = phi[1] - phi[0]
+
+    def measure(x: float) -> float:
+        value = group.position(_chain(mech, structure, plans, i, np.array([x])), 1).conditioning[0]
+        return float(value) if np.isfinite(value) else 2.0
+
+    found, swaps = [], []
+    for k in cells:
+        best = minimize_scalar(measure, bounds=(phi[k] - step, phi[k] + step), method="bounded",
+                               options={"xatol": 1e-12})
+        if best.fun > CHANGE_POINT_TOL:
+            continue
+        swap = _swaps(mech, structure, plans, i, float(best.x))
+        if swap is None:
+            continue  # one side cannot be assembled: a limit position, not a change point
+        angle = float(best.x) % TWO_PI
+        if any(abs((angle - a + np.pi) % TWO_PI - np.pi) < 1e-9 for a in found):
+            continue
+        found.append(angle)
+        swaps.append(swap)
+    order = np.argsort(found)
+    return np.asarray(found, float)[order], np.asarray(swaps, bool)[order]
+
+
+# Lagrange weights that extrapolate values at t = -3, -2, -1 to t = 1, 2, 3 (rows)
+_NODES = np.array([-3.0, -2.0, -1.0])
+_EXTRAPOLATE = np.array([[np.prod([(t - n) / (m - n) for n in _NODES if n != m]) for m in _NODES]
+                         for t in (1.0, 2.0, 3.0)])
+
+
+def _swaps(mech, structure, plans, i, angle) -> bool | None:
+    """Whether branch +1 on the left of ``angle`` goes on as branch -1 on its right (None when
+    one side cannot be assembled)."""
+    group = structure.groups[i]
+    offsets = CROSSING_STEP * np.array([-3.0, -2.0, -1.0, 1.0, 2.0, 3.0])
+    poses = _chain(mech, structure, plans, i, angle + offsets)
+    features = {}
+    for m in group.branches:
+        placed = group.position(poses, m)
+        if np.any(placed.status == -1):
+            return None
+        merged = {**poses, **placed.poses}
+        contacts = group.contact_points(merged)                      # (6, J, 2)
+        scale = np.max(np.linalg.norm(contacts - contacts.mean(axis=1, keepdims=True), axis=-1)) or 1.0
+        parts = [contacts.reshape(6, -1)]
+        for link in group.links:
+            theta = merged[link][:, 2]
+            parts.append(scale * np.column_stack([np.cos(theta), np.sin(theta)]))
+        features[m] = np.concatenate(parts, axis=1)
+    predicted = _EXTRAPOLATE @ features[1][:3]
+    miss = {m: np.linalg.norm(predicted - features[m][3:]) for m in group.branches}
+    return bool(miss[-1] < miss[1])
