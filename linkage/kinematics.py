@@ -275,6 +275,7 @@ def analyze(
             first.update(d1)
             if second is not None:
                 second.update(d2)
+            _check_jumps(group, plans[i], poses, first, placed.status, phi)
     bad = status != OK
     for d in (first, second):
         if d is not None and bad.any():
@@ -369,3 +370,47 @@ def _check_change_points(group, plan, phi) -> None:
         warnings.warn(
             f"group {group!r}, followed through {int(np.sum(plan.swaps))} change point(s) per turn, "
             "repeats its motion only after two turns of the input", BranchWarning, stacklevel=3)
+
+
+#: largest step between analysed angles (rad) over which :func:`_check_jumps` compares the motion
+#: with its analogs (beyond it the trapezoid rule is too coarse to tell a jump from a fast motion)
+JUMP_CHECK_STEP = np.pi / 18
+
+
+def _check_jumps(group, plan, poses, first, status, phi) -> None:
+    """Warn where a group moves between two analysed angles (at most 10 deg apart) by more than
+    its first analogs allow: the displacement of points fixed in its links differs from the
+    trapezoid rule on their analogs by more than half of either (a change point or a singular
+    position passed between the angles, with no other warning)."""
+    if len(phi) < 2:
+        return
+    dphi = np.diff(phi)
+    pairs = (status[:-1] == OK) & (status[1:] == OK) & (np.abs(dphi) <= JUMP_CHECK_STEP) & (dphi != 0)
+    for c in plan.change_points if plan.mode == "keep" else ():      # already reported
+        lo, hi = np.minimum(phi[:-1], phi[1:]), np.maximum(phi[:-1], phi[1:])
+        pairs &= ~(np.floor((hi - c) / (2 * np.pi)) > np.floor((lo - c) / (2 * np.pi)))
+    if not pairs.any():
+        return
+    contacts = group.contact_points(poses)
+    scale = float(np.nanmedian(np.max(np.linalg.norm(contacts - contacts.mean(axis=1, keepdims=True),
+                                                     axis=-1), axis=1))) or group.size
+    moved, allowed = [], []
+    for link in group.links:
+        origin = np.zeros(2)
+        for local in (origin, origin + (scale, 0.0), origin + (0.0, scale)):
+            p = global_point(poses[link], local)
+            d1, _ = point_analogs(poses[link], first[link], None, local)
+            moved.append(np.diff(p, axis=0))
+            allowed.append(0.5 * (d1[:-1] + d1[1:]) * dphi[:, None])
+    moved, allowed = np.concatenate(moved, axis=1), np.concatenate(allowed, axis=1)
+    miss = np.linalg.norm(moved - allowed, axis=1)
+    reference = np.linalg.norm(moved, axis=1) + np.linalg.norm(allowed, axis=1)
+    with np.errstate(invalid="ignore"):
+        bad = pairs & (miss > 0.5 * reference) & (miss > 1e-9 * scale)
+    if bad.any():
+        k = np.flatnonzero(bad)
+        shown = ", ".join(f"{np.degrees(phi[j]):.6g}..{np.degrees(phi[j + 1]):.6g}" for j in k[:5])
+        warnings.warn(
+            f"group {group!r} moves between the input angles {shown} deg more than its analogs "
+            "allow: it passes a change point or a singular position between them (analyse finer "
+            "angles there)", BranchWarning, stacklevel=3)

@@ -230,3 +230,18 @@ def test_a_four_bar_that_never_assembles_names_the_group_and_the_dimensions():
 def test_a_condition_that_holds_on_neither_candidate_at_its_angle_is_refused():
     with pytest.raises(linkage.SchemeError, match="does not tell the two branches"):
         linkage.loads(four_bar(1, 2, 1, 2, 'left_of = ["A", "C"]\nphi_deg = 0'))
+
+
+def test_a_jump_the_change_point_search_missed_is_still_reported():
+    """Safety net: with the change point hidden from the plan, the deltoid's 4 m jump between two
+    analysed angles 1 deg apart is reported by comparing the motion with its analogs."""
+    from linkage.assembly import BranchPlan
+    from linkage.kinematics import _cache
+
+    mech = linkage.loads(four_bar(1, 2, 2, 1, 'left_of = ["A", "C"]'))
+    _cache(mech)["plans"] = (BranchPlan(1, "keep", np.empty(0), np.empty(0, bool)),)
+    _, caught = _analyze(mech, np.radians([-1.5, -0.5, 0.5, 1.5]))
+    assert len(caught) == 1 and "-0.5..0.5" in caught[0] and "II-RRR(2,3)" in caught[0]
+    # and a smooth motion sampled just as finely, or coarsely, raises nothing
+    _, caught = _analyze(linkage.load("four_bar"), np.radians(np.arange(0.0, 360.0, 10.0)))
+    assert caught == []
