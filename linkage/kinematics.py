@@ -21,7 +21,7 @@ from typing import Iterable, Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
-from assur.base import CANNOT_ASSEMBLE, OK, SINGULAR, global_point, perp, point_analogs, rotate
+from assur.base import ANALOG_TOL, CANNOT_ASSEMBLE, OK, SINGULAR, global_point, perp, point_analogs, rotate
 
 from .assembly import assembly_branches, assembly_plans, place_group
 from .errors import AssemblyError, StructureError
@@ -282,7 +282,7 @@ def analyze(
             for k in d:
                 d[k] = np.where(bad[:, None], np.nan, d[k])
     if on_failure == "raise" and bad.any():
-        raise AssemblyError(_failure_message(mech, phi, status), np.degrees(phi[bad]))
+        raise AssemblyError(_failure_message(mech, phi, status, conditioning), np.degrees(phi[bad]))
     omega_arr = eps_arr = None
     if omega is not None:
         omega_arr = np.broadcast_to(np.asarray(omega, dtype=float), phi.shape).copy()
@@ -326,13 +326,21 @@ def _input_state(mech: Mechanism, structure: Structure, phi: np.ndarray, order: 
     return poses, first, second
 
 
-def _failure_message(mech: Mechanism, phi: np.ndarray, status: np.ndarray) -> str:
+def _failure_message(mech: Mechanism, phi: np.ndarray, status: np.ndarray, conditioning: dict) -> str:
     parts = []
     for code, what in ((CANNOT_ASSEMBLE, "cannot be assembled"), (SINGULAR, "is singular")):
         angles = np.degrees(phi[status == code])
         if len(angles):
             shown = ", ".join(f"{a:.6g}" for a in angles[:20]) + (" ..." if len(angles) > 20 else "")
             parts.append(f"{what} at {len(angles)} input angle(s) (deg): {shown}")
+    singular = status == SINGULAR
+    if singular.any():
+        worst = {g: float(np.nanmin(r[singular])) for g, r in conditioning.items()
+                 if np.any(np.isfinite(r[singular]))}
+        group = min(worst, key=worst.get)
+        parts.append(f"group {group} is nearly singular there (conditioning {worst[group]:.2g}, where 1 "
+                     f"is well proportioned: too low to keep its analogs to {ANALOG_TOL:g} relative; "
+                     "see Motion.conditioning)")
     return (f"mechanism '{mech.name}' " + "; ".join(parts)
             + " (use on_failure='mask' to get a per-position status instead)")
 
