@@ -6,7 +6,7 @@ scheme file (:mod:`linkage.scheme`) or in Python; it is decomposed into Assur gr
 transfer functions (:mod:`linkage.kinematics`).
 """
 
-from .errors import AssemblyError, LinkageError, SchemeError, StructureError
+from .errors import AssemblyError, InputError, LinkageError, SchemeError, StructureError
 from .extremes import extreme_positions, table_angles
 from .kinematics import Motion, analyze, structure_of
 from .model import Mechanism, MechanismBuilder
@@ -15,7 +15,7 @@ from .structure import decompose, mobility
 from . import forces, dynamics  # noqa: F401  (register the [loads] and [dynamics] sections)
 
 __all__ = [
-    "AssemblyError", "LinkageError", "SchemeError", "StructureError", "Mechanism",
+    "AssemblyError", "InputError", "LinkageError", "SchemeError", "StructureError", "Mechanism",
     "MechanismBuilder", "Motion", "analyze", "decompose", "dumps", "extreme_positions", "load",
     "loads", "mobility", "save", "shipped_schemes", "structure_of", "table_angles",
 ]

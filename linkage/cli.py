@@ -12,7 +12,9 @@ Every subcommand is one ``_add_<name>(subparsers)`` function that registers its 
 the registering function in :data:`COMMANDS`. Tables go to stdout through
 :func:`linkage.report.format_columns`; notes, warnings and errors go to stderr. Errors of the
 input (:class:`linkage.LinkageError`, ``ValueError``) print one line per problem and exit with
-status 2, without a traceback.
+status 2, without a traceback; warnings are printed as ``linkage: warning: ...`` lines (never as
+Python's warning text); an unexpected exception (a bug) prints one ``internal error`` line and
+exits with status 1.
 """
 
 from __future__ import annotations
@@ -27,12 +29,13 @@ from typing import Callable, Sequence
 import numpy as np
 
 from . import __version__
-from .errors import LinkageError, SchemeError
+from .errors import InputError, LinkageError, SchemeError
 from .extremes import table_angles
 from .kinematics import analyze, structure_of
 from .motors import RPM
+from .model import MAX_ANGLE_DEG, MAX_MAGNITUDE, MAX_POSITIONS
 from .report import FORMATS, format_columns
-from .scheme import load, shipped_schemes
+from .scheme import load, section_of, shipped_schemes
 
 __all__ = ["main", "COMMANDS"]
 
@@ -40,13 +43,19 @@ PROG = "linkage"
 
 #: exit status of errors in the user's input (same as argparse's usage errors)
 EXIT_INPUT = 2
+#: exit status of an unexpected exception (a bug of the library)
+EXIT_INTERNAL = 1
+
+
+def _declared_dynamics(mech):
+    """The scheme's dynamics inputs (parsed once, with the scheme), or None."""
+    return section_of(mech, "dynamics")
 
 
 def _rotation(mech) -> int:
     """Order of table positions: the sign of the scheme's declared mean speed, else +1."""
-    from .dynamics import dynamics_of
-
-    return dynamics_of(mech).rotation if mech.extra.get("dynamics") is not None else 1
+    spec = _declared_dynamics(mech)
+    return spec.rotation if spec is not None else 1
 
 
 # ----------------------------------------------------------------------------------------------
@@ -120,8 +129,8 @@ def _positions(text: str) -> int:
         n = int(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"expected a whole number of positions, got {text!r}") from None
-    if n < 1:
-        raise argparse.ArgumentTypeError(f"the number of positions must be >= 1, got {n}")
+    if not 1 <= n <= MAX_POSITIONS:
+        raise argparse.ArgumentTypeError(f"the number of positions must be in [1, {MAX_POSITIONS}], got {n}")
     return n
 
 
@@ -133,9 +142,21 @@ def _start(text: str) -> str | float:
     except ValueError:
         raise argparse.ArgumentTypeError(
             f"expected 'extreme', 'max', 'min' or an angle in degrees, got {text!r}") from None
-    if not math.isfinite(deg):
-        raise argparse.ArgumentTypeError(f"the start angle must be finite, got {text!r}")
+    if not (math.isfinite(deg) and abs(deg) <= MAX_ANGLE_DEG):
+        raise argparse.ArgumentTypeError(f"the start angle must be a finite number of degrees with "
+                                         f"|x| <= {MAX_ANGLE_DEG:g}, got {text!r}")
     return deg
+
+
+def _real(text: str) -> float:
+    """A finite number within the declared range of every number (|x| <= 1e50)."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
+    if not (math.isfinite(value) and abs(value) <= MAX_MAGNITUDE):
+        raise argparse.ArgumentTypeError(f"expected a finite number with |x| <= {MAX_MAGNITUDE:g}, got {text!r}")
+    return value
 
 
 def _add_scheme_argument(p: argparse.ArgumentParser) -> None:
@@ -178,9 +199,9 @@ def _table_positions(mech, n: int, start: str | float, direction: int) -> tuple[
         start = 0.0
     try:
         return table_angles(mech, n, start, direction), start
-    except ValueError as exc:
-        if isinstance(start, str) and not isinstance(exc, LinkageError):
-            raise ValueError(f"{exc} (choose position 1 with --start DEG)") from None
+    except InputError as exc:  # e.g. the output has no extreme position
+        if isinstance(start, str):
+            raise InputError(f"{exc} (choose position 1 with --start DEG)") from None
         raise
 
 
@@ -251,9 +272,9 @@ def _report_failures(motion) -> list[dict]:
 
 def _add_speed_arguments(p: argparse.ArgumentParser, what: str) -> None:
     speed = p.add_mutually_exclusive_group()
-    speed.add_argument("--omega", metavar="RAD_S", type=float,
+    speed.add_argument("--omega", metavar="RAD_S", type=_real,
                        help=f"{what}, rad/s, signed (negative: clockwise)")
-    speed.add_argument("--rpm", metavar="RPM", type=float, help=f"{what}, rpm, signed")
+    speed.add_argument("--rpm", metavar="RPM", type=_real, help=f"{what}, rpm, signed")
 
 
 def _speed(args) -> float | None:
@@ -276,7 +297,7 @@ def _add_forces(sub) -> None:
     _add_positions_arguments(p)
     _add_speed_arguments(p, "input angular velocity (default: the scheme's mean speed, else "
                             "none: a static analysis)")
-    p.add_argument("--eps", metavar="RAD_S2", type=float, default=0.0,
+    p.add_argument("--eps", metavar="RAD_S2", type=_real, default=0.0,
                    help="input angular acceleration, rad/s^2 (default 0)")
     _add_format_argument(p)
     p.set_defaults(handler=_cmd_forces)
@@ -287,10 +308,8 @@ def _cmd_forces(args: argparse.Namespace) -> int:
 
     mech = load(args.scheme)
     omega = _speed(args)
-    if omega is None and mech.extra.get("dynamics") is not None:
-        from .dynamics import dynamics_of
-
-        omega = dynamics_of(mech).mean_speed
+    if omega is None and _declared_dynamics(mech) is not None:
+        omega = _declared_dynamics(mech).mean_speed
     if omega is None and args.eps != 0:
         _note("note", "no speed given: omega = 0 with the given eps")
         omega = 0.0
@@ -335,7 +354,7 @@ def _add_dynamics(sub) -> None:
     _add_scheme_argument(p)
     p.add_argument("--positions", "-n", metavar="N", type=_positions, default=None,
                    help="N equal steps per revolution (default: the scheme's, else 12)")
-    p.add_argument("--delta", metavar="D", type=float, default=None,
+    p.add_argument("--delta", metavar="D", type=_real, default=None,
                    help="coefficient of speed fluctuation (default: the scheme's)")
     _add_speed_arguments(p, "mean speed of the input link (default: the scheme's)")
     p.add_argument("--method", choices=("course", "exact", "ode"), default="course",
@@ -393,16 +412,38 @@ def main(argv: Sequence[str] | None = None) -> int:
         args = parser.parse_args(argv)
     except SystemExit as exc:  # --help, --version, usage errors (status 2)
         return exc.code if isinstance(exc.code, int) else (0 if exc.code is None else EXIT_INPUT)
-    try:
-        return args.handler(args)
-    except (LinkageError, ValueError) as exc:
-        for line in _error_lines(exc):
-            _note("error", line)
-        return EXIT_INPUT
-    except BrokenPipeError:  # e.g. `linkage analyze ... | head`: the reader left, not an error
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
         try:
-            devnull = os.open(os.devnull, os.O_WRONLY)
-            os.dup2(devnull, sys.stdout.fileno())
-        except (OSError, ValueError, AttributeError):
-            pass
-        return 0
+            return args.handler(args)
+        except (LinkageError, ValueError) as exc:  # ValueError: a bad argument found by numpy / scipy
+            for line in _error_lines(exc):
+                _note("error", line)
+            return EXIT_INPUT
+        except BrokenPipeError:  # e.g. `linkage analyze ... | head`: the reader left, not an error
+            try:
+                devnull = os.open(os.devnull, os.O_WRONLY)
+                os.dup2(devnull, sys.stdout.fileno())
+            except (OSError, ValueError, AttributeError):
+                pass
+            return 0
+        except Exception as exc:  # a bug of the library: one line, no traceback
+            _note("error", f"internal error ({type(exc).__name__}: {exc}); please report it with the "
+                           "command line that caused it")
+            return EXIT_INTERNAL
+        finally:
+            _report_warnings(caught)
+
+
+def _report_warnings(caught) -> None:
+    """The library's warnings as ``linkage: warning:`` lines; floating-point warnings of numpy
+    (overflow, invalid value ...) as one line in the library's words."""
+    numerical = False
+    for w in caught:
+        if issubclass(w.category, RuntimeWarning):
+            numerical = True
+        else:
+            _note("warning", str(w.message))
+    if numerical:
+        _note("warning", "a floating-point overflow or invalid value occurred in the computation: "
+                         "check the results")

@@ -31,14 +31,14 @@ from scipy.integrate import solve_ivp
 from scipy.interpolate import CubicSpline
 from scipy.optimize import brentq
 
-from .errors import LinkageError
-from .extremes import table_angles
+from .errors import LinkageError, SchemeError
+from .extremes import extreme_positions, table_angles
 from .kinematics import analyze
 from .kinetostatics import solve_reactions
-from .model import Mechanism, _is_number
+from .model import MAX_POSITIONS, Mechanism, _is_number, check_number, unknown_keys
 from .motors import RPM, ConstantMotor, motor_from_spec
 from .reduced import Reduced, reduced_characteristics
-from .scheme import SECTION_VALIDATORS
+from .scheme import register_section, section_of
 
 __all__ = [
     "DynamicsError",
@@ -69,15 +69,19 @@ class DynamicsInputError(DynamicsError, ValueError):
 
 
 #: The exact energy method resolves ``delta`` from speeds computed in float64: each carries a
-#: relative rounding error of a few 1e-16, so the computed delta is uncertain by ~1e-15 and the
-#: constant inertia found for it by ~1e-15 / delta (relative). Below this delta the answer would
-#: be mostly rounding: :func:`exact_method` refuses it (Mertsalov's :func:`course_method`, exact
-#: in the limit delta -> 0, has no such floor).
+#: relative rounding error of ~1e-16, so the computed delta is uncertain by ~1e-16 and the
+#: constant inertia found for it by ~1e-16 / delta relative (measured on course_slider_crank
+#: against the linear limit of Mertsalov's method: 1e-11 at delta = 1e-6, 1.2e-7 at 1e-9). Below
+#: this delta the answer would be mostly rounding: :func:`exact_method` refuses it (Mertsalov's
+#: :func:`course_method`, exact in the limit delta -> 0, has no such floor).
 DELTA_RESOLVED = 1e-9
 
-#: ``k_dyn`` is reported only when ``|M_d|`` exceeds this fraction of the machine's moment scale
-#: (the largest of ``|M_b|`` and ``|M_red|`` over the cycle): below it the mean driving moment is
-#: round-off of a cycle that needs no net drive (conservative loads), and their ratio means nothing.
+#: ``k_dyn`` is reported only when the cycle's mean driving moment, on the exact method's fine
+#: grid, exceeds this fraction of the machine's moment scale (the largest of ``|M_b|`` and
+#: ``|M_red|`` over the cycle): below it the cycle needs no net drive (conservative loads such as
+#: gravity alone), the mean driving moment is round-off or the quadrature error of the table
+#: positions (2.6e-6 of the scale for a four-bar under gravity at 12 positions), and the ratio
+#: means nothing.
 MEAN_MOMENT_RESOLVED = 1e-9
 
 
@@ -108,8 +112,8 @@ def _check_spec(spec: DynamicsSpec) -> DynamicsSpec:
     _require(math.isfinite(w2) and w2 >= sys.float_info.min, "mean_speed", w,
              "a speed whose square (the scale of the kinetic energy) float64 holds: "
              f"{math.sqrt(sys.float_info.min):.3g} <= |mean_speed| <= {math.sqrt(sys.float_info.max):.3g} rad/s")
-    _require(spec.delta is None or (_real(spec.delta) and 0 < spec.delta < 2), "delta", spec.delta,
-             "a number in (0, 2): (omega_max - omega_min) / omega_m reaches 2 only when omega_min = 0")
+    _require(spec.delta is None or (_real(spec.delta) and spec.delta > 0), "delta", spec.delta,
+             "a finite number > 0 (the coefficient of speed fluctuation)")
     _require_count("positions", spec.positions)
     _require_count("cycles", spec.cycles)
     for name in ("inertia_0", "flywheel"):
@@ -130,9 +134,10 @@ def _check_spec(spec: DynamicsSpec) -> DynamicsSpec:
 def _kinetic_energy(inertia: float, speed: float, what: str) -> float:
     """``inertia speed^2 / 2`` (J) in float64; DynamicsError naming ``what`` when it overflows."""
     energy = float(inertia) * float(speed) * float(speed) / 2  # python floats: inf, never an exception
-    if not math.isfinite(energy):
+    if not math.isfinite(energy) or (energy == 0 and inertia != 0 and speed != 0):
         raise DynamicsError(f"{what}: the kinetic energy I w^2 / 2 = {float(inertia):.6g} kg m^2 x "
-                            f"({float(speed):.6g} rad/s)^2 / 2 overflows float64")
+                            f"({float(speed):.6g} rad/s)^2 / 2 {'underflows' if energy == 0 else 'overflows'} "
+                            "float64")
     return energy
 
 
@@ -190,61 +195,90 @@ class DynamicsSpec:
         return self.inertia_0 + sum(j * u * u for j, u in self.rotors) + self.flywheel
 
 
+#: Largest number of cycles of a start-up transient a scheme may declare (the integration time
+#: grows with it); the largest number of table positions is :data:`linkage.model.MAX_POSITIONS`.
+MAX_CYCLES = 1_000
+
+
+def _count(raw: Mapping[str, Any], key: str, largest: int, problems: list[str]) -> int | None:
+    v = raw[key]
+    if isinstance(v, int) and not isinstance(v, bool) and 1 <= v <= largest:
+        return v
+    problems.append(f"{key} must be a whole number in [1, {largest}], got {v!r}")
+    return None
+
+
 def parse_dynamics(mech: Mechanism, raw: Mapping[str, Any] | None) -> tuple[DynamicsSpec | None, list[str]]:
-    """The dynamics inputs and the list of problems from a scheme's ``[dynamics]`` table."""
+    """The dynamics inputs and the list of problems from a scheme's ``[dynamics]`` table.
+
+    Every number is checked against its range (``schemes/README.md``, "Ranges"): speeds nonzero
+    and within [1e-50, 1e50] in magnitude, ``delta`` in [DELTA_RESOLVED, 2), inertias >= 0,
+    ``positions`` and ``cycles`` whole numbers up to :data:`MAX_POSITIONS` / :data:`MAX_CYCLES`.
+    A cycle that starts at the output's extreme position needs the output to have one: it is
+    found here, once.
+    """
     if raw is None:
         return None, []
     if not isinstance(raw, Mapping):
         return None, [f"expected a table, got {raw!r}"]
     known = {"mean_speed", "mean_rpm", "delta", "positions", "start_deg", "inertia_0", "rotors",
              "flywheel", "motor", "initial_speed", "initial_rpm", "cycles"}
-    problems = []
-    if set(raw) - known:
-        problems.append(f"unknown keys {sorted(set(raw) - known)} (known: {sorted(known)})")
+    problems: list[str] = []
+    if unknown_keys(raw, known, "", problems):
+        return None, problems
     if ("mean_speed" in raw) == ("mean_rpm" in raw):
         problems.append("give exactly one of mean_speed (rad/s, signed) or mean_rpm (signed)")
         return None, problems
-    speed = raw.get("mean_speed", raw.get("mean_rpm"))
-    if not _is_number(speed) or speed == 0:
-        problems.append(f"mean speed must be a nonzero number (its sign is the rotation), got {speed!r}")
-        return None, problems
-    speed = float(speed) * (RPM if "mean_rpm" in raw else 1.0)
-    args: dict[str, Any] = {"mean_speed": speed}
-    for key, strict in (("delta", True), ("inertia_0", False), ("flywheel", False)):
+    key = "mean_speed" if "mean_speed" in raw else "mean_rpm"
+    speed = check_number(raw[key], "", f"{key} (signed: the sign is the rotation)", problems,
+                         "nonzero", "rad/s" if key == "mean_speed" else "rpm")
+    args: dict[str, Any] = {"mean_speed": (speed or 1.0) * (RPM if key == "mean_rpm" else 1.0)}
+    if "delta" in raw:
+        v = raw["delta"]
+        if _is_number(v) and DELTA_RESOLVED <= v < 2:
+            args["delta"] = float(v)
+        else:
+            problems.append(f"delta must be a number in [{DELTA_RESOLVED:g}, 2) ((omega_max - "
+                            f"omega_min) / omega_m; below {DELTA_RESOLVED:g} it is rounding), got {v!r}")
+    for key in ("inertia_0", "flywheel"):
         if key in raw:
-            v = raw[key]
-            if not _is_number(v) or v < 0 or (strict and v == 0):
-                problems.append(f"{key} must be a number {'> 0' if strict else '>= 0'}, got {v!r}")
-            else:
-                args[key] = float(v)
-    for key in ("positions", "cycles"):
+            args[key] = check_number(raw[key], "", key, problems, "nonnegative", "kg m^2")
+    for key, largest in (("positions", MAX_POSITIONS), ("cycles", MAX_CYCLES)):
         if key in raw:
-            v = raw[key]
-            if not isinstance(v, int) or isinstance(v, bool) or v < 1:
-                problems.append(f"{key} must be a positive integer, got {v!r}")
-            else:
-                args[key] = v
+            args[key] = _count(raw, key, largest, problems)
     if "start_deg" in raw:
-        if not _is_number(raw["start_deg"]):
-            problems.append(f"start_deg must be a number, got {raw['start_deg']!r}")
-        else:
-            args["start"] = float(raw["start_deg"])
+        args["start"] = check_number(raw["start_deg"], "", "start_deg", problems, "angle_deg", "deg")
     elif mech.output is None:
-        problems.append("the cycle starts at the output's extreme position: declare an output or start_deg")
+        problems.append("the cycle starts at the output's extreme position: declare an output "
+                        "or start_deg")
+    else:
+        try:
+            extreme_positions(mech)
+        except (LinkageError, ValueError) as exc:
+            problems.append(f"the cycle starts at the output's extreme position, but {exc}: "
+                            "declare start_deg")
     rotors = []
-    for i, r in enumerate(raw.get("rotors", [])):
-        if not (isinstance(r, Mapping) and _is_number(r.get("inertia")) and r["inertia"] >= 0
-                and _is_number(r.get("ratio", 1.0))):
-            problems.append(f"rotors[{i}]: expected {{inertia = J (kg m^2), ratio = U}}, got {r!r}")
-        else:
-            rotors.append((float(r["inertia"]), float(r.get("ratio", 1.0))))
+    raw_rotors = raw.get("rotors", [])
+    if not isinstance(raw_rotors, list):
+        problems.append(f"rotors: expected a list of {{inertia = J (kg m^2), ratio = U}}, got {raw_rotors!r}")
+        raw_rotors = []
+    for i, r in enumerate(raw_rotors):
+        where = f"rotors[{i}]"
+        if not isinstance(r, Mapping):
+            problems.append(f"{where}: expected {{inertia = J (kg m^2), ratio = U}}, got {r!r}")
+            continue
+        if unknown_keys(r, {"inertia", "ratio"}, where, problems):
+            continue
+        inertia = check_number(r.get("inertia"), where, "inertia", problems, "nonnegative", "kg m^2")
+        ratio = check_number(r.get("ratio", 1.0), where, "ratio", problems, "real")
+        if inertia is not None and ratio is not None:
+            rotors.append((inertia, ratio))
     args["rotors"] = tuple(rotors)
     if "initial_speed" in raw or "initial_rpm" in raw:
-        v = raw.get("initial_speed", raw.get("initial_rpm"))
-        if not _is_number(v) or v <= 0:
-            problems.append(f"initial speed must be a number > 0 (|omega| at the start), got {v!r}")
-        else:
-            args["initial_speed"] = float(v) * (RPM if "initial_rpm" in raw else 1.0)
+        key = "initial_speed" if "initial_speed" in raw else "initial_rpm"
+        v = check_number(raw[key], "", f"{key} (|omega| at the start)", problems, "positive",
+                         "rad/s" if key == "initial_speed" else "rpm")
+        args["initial_speed"] = v * (RPM if key == "initial_rpm" else 1.0) if v else None
     if "motor" in raw:
         motor, motor_problems = motor_from_spec(raw["motor"])
         problems += motor_problems
@@ -253,18 +287,22 @@ def parse_dynamics(mech: Mechanism, raw: Mapping[str, Any] | None) -> tuple[Dyna
 
 
 def dynamics_of(mech: Mechanism) -> DynamicsSpec:
-    """The dynamics inputs a mechanism declares; ``ValueError`` when it declares none."""
-    spec, problems = parse_dynamics(mech, mech.extra.get("dynamics"))
-    if problems:
-        from .errors import SchemeError
+    """The dynamics inputs a mechanism declares (its ``[dynamics]`` section).
 
-        raise SchemeError([f"mechanism '{mech.name}' dynamics: {p}" for p in problems])
+    Parsed once (when the scheme is loaded, or on first use) and kept on the mechanism.
+
+    Raises
+    ------
+    SchemeError
+        When the section is declared wrongly, or when the mechanism declares none.
+    """
+    spec = section_of(mech, "dynamics")
     if spec is None:
-        raise ValueError(f"mechanism '{mech.name}' declares no [dynamics] section (mean speed, delta, ...)")
+        raise SchemeError(f"mechanism '{mech.name}' declares no [dynamics] section (mean speed, delta, ...)")
     return spec
 
 
-SECTION_VALIDATORS["dynamics"] = lambda mech, raw: parse_dynamics(mech, raw)[1]
+register_section("dynamics", parse_dynamics)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -325,7 +363,7 @@ class LawOfMotion:
 
 
 def _cycle(mech: Mechanism, spec: DynamicsSpec, positions: int | None = None):
-    n = positions or spec.positions
+    n = spec.positions if positions is None else positions
     phi = table_angles(mech, n, spec.start, spec.rotation)
     ends = np.zeros(n + 1, bool)
     ends[-1] = True
@@ -346,12 +384,24 @@ def course_method(mech: Mechanism, spec: DynamicsSpec | None = None, *, position
                   delta: float | None = None, mean_speed: float | None = None) -> LawOfMotion:
     """Mertsalov's method on the table positions (METHOD section 6).
 
-    ``positions``, ``delta`` and ``mean_speed`` override the declared inputs.
+    ``positions``, ``delta`` and ``mean_speed`` override the declared inputs. The method is plain
+    arithmetic on the table (no tolerance): a consistently scaled machine gives results scaled
+    to rounding (~1e-15 relative).
+
+    Raises
+    ------
+    DynamicsInputError
+        An argument out of range (``delta`` missing or not a finite number > 0, ``mean_speed`` zero or
+        beyond float64's range, ``positions`` < 1 ...), or a ``delta`` so small that the constant
+        inertia it needs overflows float64.
+    DynamicsError
+        The machine has no inertia at the crank and needs none, so its speed is undetermined.
     """
-    spec = _override(mech, spec, delta, mean_speed)
+    spec = _override(mech, spec, delta, mean_speed, positions)
     if spec.delta is None:
-        raise ValueError("the course method needs delta (the coefficient of speed fluctuation)")
-    phi, ends = _cycle(mech, spec, positions)
+        raise DynamicsInputError(f"mechanism '{mech.name}': the course method needs delta (the coefficient of "
+                                 "speed fluctuation): declare it in [dynamics] or pass delta=")
+    phi, ends = _cycle(mech, spec)
     n = len(phi) - 1
     red = reduced_characteristics(mech, phi, spec.rotation, extra_inertia=spec.constant_inertia, ends=ends)
     step = 2 * np.pi / n
@@ -360,14 +410,24 @@ def course_method(mech: Mechanism, spec: DynamicsSpec | None = None, *, position
     psi = np.arange(n + 1) * step
     energy = driving * psi + work  # Delta T
     wm = abs(spec.mean_speed)
-    energy_links = red.inertia_variable * wm**2 / 2  # T''
+    wm2 = wm * wm
+    _kinetic_energy(red.inertia_constant + float(np.max(red.inertia_variable)), wm, f"mechanism '{mech.name}'")
+    energy_links = red.inertia_variable * wm2 / 2  # T''
     energy_flywheel = energy - energy_links  # Delta T'
     swing = float(np.max(energy_flywheel) - np.min(energy_flywheel))
-    required = swing / (spec.delta * wm**2)
+    required = swing / spec.delta / wm2
+    if not math.isfinite(required):
+        raise DynamicsInputError(f"delta = {spec.delta!r}: the constant inertia it needs, Delta T'_ab / (delta "
+                                 f"w_m^2) = {swing:.6g} J / ({spec.delta!r} x {wm2:.6g} rad^2/s^2), overflows "
+                                 "float64")
     flywheel = required - red.inertia_constant
     constant = max(required, red.inertia_constant)
-    delta_actual = spec.delta if flywheel > 0 else swing / (red.inertia_constant * wm**2)
-    mean_energy = constant * wm**2 / 2
+    if not constant > 0:
+        raise DynamicsError(f"mechanism '{mech.name}': no constant inertia at the crank (I_0 = 0) and none "
+                            "needed for delta (no energy swing): the speed is undetermined; declare the "
+                            "crank's or the rotors' inertia")
+    delta_actual = spec.delta if flywheel > 0 else swing / (red.inertia_constant * wm2)
+    mean_energy = constant * wm2 / 2
     energy_total = mean_energy + energy_flywheel - (np.max(energy_flywheel) + np.min(energy_flywheel)) / 2
     w = np.sqrt(2 * energy_total / constant)
     inertia = constant + red.inertia_variable
@@ -378,22 +438,26 @@ def course_method(mech: Mechanism, spec: DynamicsSpec | None = None, *, position
                         "energy_flywheel": energy_flywheel, "energy_swing": swing})
 
 
-def _override(mech, spec, delta, mean_speed) -> DynamicsSpec:
+def _override(mech, spec, delta, mean_speed, positions=None) -> DynamicsSpec:
+    """The declared (or given) inputs with the arguments that override them, all checked."""
     if spec is None:
         if mech.extra.get("dynamics") is None and mean_speed is not None:
-            spec = DynamicsSpec(mean_speed=mean_speed)
+            _require(_real(mean_speed) and mean_speed != 0, "mean_speed", mean_speed,
+                     "a finite nonzero number (rad/s; its sign is the rotation)")
+            spec = DynamicsSpec(mean_speed=float(mean_speed))
         else:
             spec = dynamics_of(mech)
-    changes = {}
+    changes: dict[str, Any] = {}
     if delta is not None:
-        if not delta > 0:
-            raise ValueError(f"delta must be > 0, got {delta!r}")
+        _require(_real(delta), "delta", delta, "a finite number > 0 (the coefficient of speed fluctuation)")
         changes["delta"] = float(delta)
     if mean_speed is not None:
-        if mean_speed == 0:
-            raise ValueError("mean speed must be nonzero (its sign is the rotation)")
+        _require(_real(mean_speed), "mean_speed", mean_speed, "a finite nonzero number (rad/s; its sign is the "
+                                                             "rotation)")
         changes["mean_speed"] = float(mean_speed)
-    return replace(spec, **changes)
+    if positions is not None:
+        changes["positions"] = positions
+    return _check_spec(replace(spec, **changes))
 
 
 # ----------------------------------------------------------------------------------------------
@@ -436,10 +500,8 @@ def _speeds(cycle: _Cycle, constant: float, mean: float) -> np.ndarray | None:
 
     if mid(low) > 0:
         return None
-    high = max(abs(low), 1e-300) + np.max(inertia) * mean**2
-    while mid(high) < 0:
-        high *= 4
-    t0 = brentq(mid, low, high, xtol=1e-14 * high, rtol=1e-15)
+    high = abs(low) + float(np.max(inertia)) * mean * mean  # mid(high) >= (sqrt(2) - 1) mean > 0
+    t0 = brentq(mid, low, high, xtol=1e-14 * high, rtol=1e-15)  # relative to the energy scale
     return np.sqrt(2 * np.maximum(t0 + cycle.energy, 0.0) / inertia)
 
 
@@ -451,34 +513,81 @@ def _delta(w: np.ndarray | None, mean: float) -> float:
     return float((np.max(w) - np.min(w)) / mean)
 
 
+_FINE_SAMPLES = 3600  # grid of the exact method (and of the cycle balance that decides k_dyn)
+
+
 def exact_method(mech: Mechanism, spec: DynamicsSpec | None = None, *, positions: int | None = None,
                  delta: float | None = None, mean_speed: float | None = None,
-                 samples: int = 3600) -> LawOfMotion:
+                 samples: int = _FINE_SAMPLES) -> LawOfMotion:
     """The energy equation solved without Mertsalov's approximation, on ``samples`` grid points.
 
     The constant driving moment balances the cycle (trapezoid on the fine grid); the kinetic
     energy ``T = T_0 + Delta T(psi)`` gives ``|omega| = sqrt(2 T / I(psi))`` with ``T_0`` such that
     ``(omega_max + omega_min) / 2 = |omega_m|``; the flywheel is the added constant inertia that
     makes ``delta`` equal the target (found by Brent's method).
+
+    Every tolerance is relative to the problem's own scale, so a consistently scaled machine
+    gives consistently scaled results: ``T_0`` to 1e-14 of the energy scale ``I_max w_m^2``, the
+    constant inertia to 1e-14 relative (plus 1e-15 of the problem's inertia scale
+    ``max I'' + I'_Mertsalov``, which does not include the declared ``I_0``). The computed delta
+    itself carries rounding of ~1e-16, so the constant inertia is accurate to about
+    ``1e-16 / delta`` relative (~1e-14 at delta = 0.01); ``delta`` below :data:`DELTA_RESOLVED`
+    is refused. When the links' own inertia keeps the fluctuation below ``delta`` even without a
+    constant inertia, the required constant inertia is reported as 1e-12 of that scale
+    (practically zero).
+
+    Raises
+    ------
+    DynamicsInputError
+        An argument out of range (see :func:`course_method`), ``samples`` < 1, or ``delta`` below
+        :data:`DELTA_RESOLVED`.
+    DynamicsError
+        No constant inertia gives the mean speed (without ``delta``), or the machine has no
+        inertia and no energy swing (its speed is undetermined).
     """
-    spec = _override(mech, spec, delta, mean_speed)
-    if positions is not None:
-        spec = replace(spec, positions=positions)
+    spec = _override(mech, spec, delta, mean_speed, positions)
+    _require_count("samples", samples)
+    if spec.delta is not None and spec.delta < DELTA_RESOLVED:
+        raise DynamicsInputError(f"delta = {spec.delta!r} is below what the exact energy method resolves in "
+                                 f"float64 (delta >= {DELTA_RESOLVED:g}: speeds carry rounding of ~1e-16 "
+                                 "relative); use the course method, exact in the limit delta -> 0")
     cycle = _fine_cycle(mech, spec, samples)
     wm = abs(spec.mean_speed)
     base = cycle.reduced.inertia_constant
+    _kinetic_energy(base + float(np.max(cycle.reduced.inertia_variable)), wm, f"mechanism '{mech.name}'")
+    # Mertsalov's I' on the fine grid: the exact answer as delta -> 0, and the problem's inertia scale
+    swing = float(np.ptp(cycle.energy - cycle.reduced.inertia_variable * (wm * wm / 2)))
+    mertsalov = swing / spec.delta / (wm * wm) if spec.delta is not None else 0.0
+    if not math.isfinite(mertsalov):
+        raise DynamicsInputError(f"delta = {spec.delta!r}: the constant inertia it needs (about {swing:.6g} J / "
+                                 f"(delta w_m^2)) overflows float64")
+    # the problem's own inertia scale: what delta needs does not depend on the declared I_0
+    scale = float(np.max(cycle.reduced.inertia_variable)) + mertsalov
     required = base
     if spec.delta is not None:
         # the constant inertia that gives exactly delta, whether or not I_0 already exceeds it
         fluctuation = lambda c: _delta(_speeds(cycle, c, wm), wm) - spec.delta  # noqa: E731
-        low = 1e-12 * (base + float(np.max(cycle.reduced.inertia_variable)) + 1e-300)
-        high = base + 1.0
-        while fluctuation(high) > 0:
-            high = 2 * high + 1.0
-        required = low if fluctuation(low) <= 0 else brentq(fluctuation, low, high, xtol=1e-13 * high,
-                                                             rtol=1e-14)
+        low = 1e-12 * scale
+        if not scale > 0:  # no variable inertia, no energy swing: the speed is constant
+            required = 0.0
+        elif fluctuation(low) <= 0:  # the links' own inertia keeps delta: (practically) none needed
+            required = low
+        else:
+            high = 2 * mertsalov + scale
+            for _ in range(64):
+                if fluctuation(high) <= 0:
+                    break
+                high *= 2
+            else:
+                raise DynamicsError(f"mechanism '{mech.name}': no constant inertia up to {high:.6g} kg m^2 "
+                                    f"gives delta = {spec.delta!r}")
+            required = brentq(fluctuation, low, high, xtol=1e-3 * low, rtol=1e-14, maxiter=200)
     flywheel = required - base if required > base else None
     constant = max(required, base)
+    if not float(np.min(constant + cycle.reduced.inertia_variable)) > 0:
+        raise DynamicsError(f"mechanism '{mech.name}': the reduced inertia vanishes (no constant inertia at the "
+                            "crank, none needed for delta): the speed is undetermined; declare the crank's or "
+                            "the rotors' inertia")
     w = _speeds(cycle, constant, wm)
     if w is None:
         raise DynamicsError(f"mechanism '{mech.name}': with the constant inertia {constant:.6g} kg m^2 "
@@ -520,18 +629,30 @@ class Transient:
 
 class _Equation:
     """``I(psi) w dw/dpsi + I'(psi) w^2 / 2 = M_d(w) + M(psi)`` in the energy form
-    ``dT/dpsi = M_d(w) + M(psi)`` with ``w = sqrt(2 T / I)``; ``dt/dpsi = 1 / w``."""
+    ``dT/dpsi = M_d(w) + M(psi)`` with ``w = sqrt(2 T / I)``; ``dt/dpsi = 1 / w``.
+
+    ``scale`` is the kinetic energy ``I_max w_m^2 / 2`` at the declared mean speed and ``work``
+    the work scale of the loads ``2 pi max|M|`` (the size of the energy changes over a cycle);
+    :func:`_integrate` takes its tolerances from them and from its own initial state."""
 
     def __init__(self, mech: Mechanism, spec: DynamicsSpec, motor, constant: float, samples: int = 720):
         cycle = _fine_cycle(mech, spec, samples)
         psi = cycle.psi
         inertia = constant + cycle.reduced.inertia_variable
         inertia[-1] = inertia[0]
+        # the problem's own scales: every tolerance of the integration is relative to them
+        self.scale = _kinetic_energy(float(np.max(inertia)), spec.mean_speed, f"mechanism '{mech.name}'")
+        self.work = 2 * np.pi * float(np.max(np.abs(cycle.reduced.moment)))
+        if not float(np.min(inertia)) > 0:
+            k = int(np.argmin(inertia))
+            raise DynamicsError(f"mechanism '{mech.name}': the reduced inertia I = {constant:.6g} + I'' vanishes at "
+                                f"psi = {math.degrees(psi[k]):.1f} deg: the equation of motion is singular; give a "
+                                "constant inertia > 0")
         self.inertia = CubicSpline(psi, inertia, bc_type="periodic")
         self.psi_grid, self.moment_grid = psi, cycle.reduced.moment
         self.motor, self.rotation = motor, spec.rotation
         self.cycle, self.constant = cycle, constant
-        self.scale = float(np.mean(inertia)) * spec.mean_speed**2 / 2
+        self.name = mech.name
 
     def moment(self, psi):
         return np.interp(np.mod(psi, 2 * np.pi), self.psi_grid, self.moment_grid)
@@ -542,25 +663,63 @@ class _Equation:
     def rhs(self, psi, state):
         energy = state[0]
         w = self.speed(psi, energy)
-        return [float(self.motor(w) + self.moment(psi)), 1.0 / max(float(w), 1e-300)]
+        driving = float(self.motor(w))
+        if not math.isfinite(driving):
+            raise DynamicsError(f"mechanism '{self.name}': the motor's moment at |omega| = {float(w):.6g} rad/s is "
+                                f"{driving!r}, not a finite number")
+        return [driving + float(self.moment(psi)), 1.0 / max(float(w), 1e-300)]
+
+
+class _Energy:
+    """The dense solution ``psi -> [T, t]`` of an integration whose state is ``[T - T_0, t]``."""
+
+    def __init__(self, dense, energy0: float):
+        self.dense, self.energy0 = dense, energy0
+
+    def __call__(self, psi):
+        out = np.array(self.dense(psi), dtype=float)
+        out[0] += self.energy0
+        return out
 
 
 def _integrate(eq: _Equation, energy0: float, cycles: float, rtol: float, atol: float | None,
                speed_limit: float) -> Any:
-    scale = eq.scale
+    """``solve_ivp`` (RK45) over ``cycles`` from the kinetic energy ``energy0``.
+
+    The state is ``[T - energy0, t]``: the energy's change, not its level, so the changes (the
+    work of the loads, the swing within a cycle) are resolved to ``rtol`` relative and ``atol``
+    absolute (default ``rtol`` times the smaller of ``energy0`` and the work scale) however
+    large the kinetic energy is (a huge flywheel), and one cycle's energy gain is read without
+    cancellation. Time: ``rtol`` and 1e-10 of one cycle at the initial speed. The machine stalls
+    when its energy falls below 1e-10 of ``energy0``. ``sol.sol`` gives ``[T, t]``. All of these
+    scales come from the integration's own state, not from the declared mean speed, which a
+    motor need not reach.
+    """
+    if not math.isfinite(energy0) or energy0 <= 0:
+        raise DynamicsError(f"mechanism '{eq.name}': the initial kinetic energy {energy0!r} J is not a finite "
+                            "positive number")
+    floor = 1e-10 * energy0
+    energy_tol = rtol * (eq.work if 0 < eq.work < energy0 else energy0)
+    time_tol = 1e-10 * 2 * np.pi / float(eq.speed(0.0, energy0))
+
+    def rhs(psi, y):
+        return eq.rhs(psi, (energy0 + y[0], y[1]))
 
     def stall(psi, y):
-        return y[0] - 1e-10 * scale
+        return (energy0 - floor) + y[0]
 
     stall.terminal, stall.direction = True, -1
 
     def runaway(psi, y):
-        return eq.speed(psi, y[0]) - speed_limit
+        return eq.speed(psi, energy0 + y[0]) - speed_limit
 
     runaway.terminal, runaway.direction = True, 1
-    return solve_ivp(eq.rhs, (0.0, 2 * np.pi * cycles), [energy0, 0.0], method="RK45", rtol=rtol,
-                     atol=[atol if atol is not None else 1e-10 * scale, 1e-10], dense_output=True,
-                     events=[stall, runaway], max_step=2 * np.pi / 90)
+    sol = solve_ivp(rhs, (0.0, 2 * np.pi * cycles), [0.0, 0.0], method="RK45", rtol=rtol,
+                    atol=[atol if atol is not None else energy_tol, time_tol],
+                    dense_output=True, events=[stall, runaway], max_step=2 * np.pi / 90)
+    if sol.sol is not None:
+        sol.sol = _Energy(sol.sol, energy0)
+    return sol
 
 
 def _raise_events(sol, eq: _Equation, what: str) -> None:
@@ -590,25 +749,59 @@ def _speed_limit(spec: DynamicsSpec, motor) -> float:
     return 10 * max(limits)
 
 
+def _check_ode_args(rtol: Any, atol: Any, samples: Any, constant_inertia: Any) -> None:
+    """DynamicsInputError naming the first out-of-range argument of :func:`simulate` /
+    :func:`steady_state`."""
+    _require(_real(rtol) and _RTOL_MIN <= rtol < 1, "rtol", rtol,
+             f"a relative tolerance in [{_RTOL_MIN:.3g}, 1) (float64 cannot meet a tighter one)")
+    _require(atol is None or (_real(atol) and atol > 0), "atol", atol, "None or a number > 0 (J)")
+    _require_count("samples", samples)
+    _require(constant_inertia is None or (_real(constant_inertia) and constant_inertia >= 0), "constant_inertia",
+             constant_inertia, "None or a finite number >= 0 (kg m^2)")
+
+
+#: the tightest relative tolerance ``solve_ivp`` accepts without changing it (100 x machine epsilon)
+_RTOL_MIN = 100 * np.finfo(float).eps
+
+
 def simulate(mech: Mechanism, spec: DynamicsSpec | None = None, *, initial_speed: float | None = None,
              cycles: int | None = None, constant_inertia: float | None = None, rtol: float = 1e-8,
              atol: float | None = None, samples: int = 720) -> Transient:
     """Start-up transient from ``initial_speed`` (|omega|, rad/s) over ``cycles`` revolutions.
 
     ``constant_inertia`` is the constant inertia at the crank (default: the declared one,
-    input link included). Raises :class:`DynamicsError` on stall or run-away.
+    input link included). The integration (RK45) controls the change of the kinetic energy
+    from its start to ``rtol`` relative and ``atol`` absolute (J; default ``rtol`` times the
+    smaller of the initial kinetic energy and the work scale ``2 pi max|M_red|``) and the time to
+    ``rtol`` relative and 1e-10 of one cycle at the initial speed: every tolerance is relative to
+    the problem's own scales, however large the flywheel. The global error is larger than
+    ``rtol`` (the reduced moment is interpolated linearly between ``samples`` points per cycle):
+    measured on the flying shears, the energy at rtol = 1e-9 is within 250 rtol of a run at
+    1e-13.
+
+    Raises
+    ------
+    DynamicsInputError
+        An argument out of range: ``initial_speed`` not a finite number > 0, ``cycles`` < 1,
+        ``rtol`` outside [2.2e-14, 1), ``atol`` <= 0, ``samples`` < 1, ``constant_inertia`` < 0,
+        or a declared input out of range.
+    DynamicsError
+        On stall or run-away, or when the kinetic energy overflows float64.
     """
-    spec = dynamics_of(mech) if spec is None else spec
+    spec = _check_spec(dynamics_of(mech) if spec is None else spec)
     w0 = initial_speed if initial_speed is not None else spec.initial_speed
-    if w0 is None or not w0 > 0:
-        raise ValueError(f"the transient needs an initial speed |omega| > 0 (rad/s), got {w0!r}")
-    constant = _default_constant(mech, spec) if constant_inertia is None else constant_inertia
+    _require(_real(w0) and w0 > 0, "initial_speed", w0, "a finite number > 0 (|omega| at the start of the "
+                                                       "transient, rad/s)")
+    if cycles is not None:
+        _require_count("cycles", cycles)
+    _check_ode_args(rtol, atol, samples, constant_inertia)
+    constant = _default_constant(mech, spec) if constant_inertia is None else float(constant_inertia)
     eq = _Equation(mech, spec, None, constant, samples)
     eq.motor = _motor_of(spec, eq.cycle.driving)
-    energy0 = float(eq.inertia(0.0)) * w0**2 / 2
+    energy0 = _kinetic_energy(float(eq.inertia(0.0)), w0, f"mechanism '{mech.name}' transient (initial_speed)")
     sol = _integrate(eq, energy0, cycles or spec.cycles, rtol, atol, _speed_limit(spec, eq.motor))
     _raise_events(sol, eq, f"mechanism '{mech.name}' transient")
-    w = eq.speed(sol.t, sol.y[0])
+    w = eq.speed(sol.t, energy0 + sol.y[0])
     return Transient(sol.t, sol.y[1], spec.rotation * w, sol.sol, sol.message)
 
 
@@ -617,20 +810,43 @@ def _default_constant(mech: Mechanism, spec: DynamicsSpec) -> float:
     return red.inertia_constant
 
 
+def _opposite(a: float, b: float) -> bool:
+    """``a`` and ``b`` bracket a root (without forming ``a b``, which may overflow)."""
+    return a == 0 or b == 0 or (a < 0) != (b < 0)
+
+
 def steady_state(mech: Mechanism, spec: DynamicsSpec | None = None, *, constant_inertia: float | None = None,
                  positions: int | None = None, rtol: float = 1e-9, samples: int = 720,
                  max_iterations: int = 60) -> LawOfMotion:
     """The periodic steady state of the equation of motion, by shooting on ``omega(0) = omega(2 pi)``.
 
     With a constant driving moment every initial speed is periodic when the moment balances the
-    cycle; the steady state is then the one with the declared mean speed.
-    Raises :class:`DynamicsError` when the machine stalls, runs away or no periodic solution is
-    found.
+    cycle; the steady state is then the one with the declared mean speed. Tolerances are relative
+    to the problem's own scales: one cycle is integrated to ``rtol`` (see :func:`simulate`), the
+    periodic initial energy is found to ``10 rtol`` relative from the energy gained over a cycle
+    (integrated directly, so a huge flywheel does not drown it), and a constant moment balances
+    the cycle when it differs from the balancing one by at most 1e-6 of the energy scale
+    ``I_max w_m^2 / 2`` (per radian). The global error is larger than ``rtol`` and erratic (the
+    reduced moment is interpolated linearly between ``samples`` points): measured on the flying
+    shears against a run at rtol = 1e-13, omega is off by 80 rtol at rtol = 1e-9 (up to 1300
+    rtol for rtol in [1e-10, 1e-8]) and the mean driving moment by 1e3 rtol (the motor's
+    characteristic turns a small speed error into a larger moment error).
+
+    Raises
+    ------
+    DynamicsInputError
+        An argument out of range (``rtol``, ``samples``, ``positions``, ``max_iterations``,
+        ``constant_inertia``; see :func:`simulate`), or a declared input out of range.
+    DynamicsError
+        When the machine stalls, runs away, no periodic solution is found, or the kinetic energy
+        overflows float64.
     """
-    spec = dynamics_of(mech) if spec is None else spec
+    spec = _check_spec(dynamics_of(mech) if spec is None else spec)
     if positions is not None:
-        spec = replace(spec, positions=positions)
-    constant = _default_constant(mech, spec) if constant_inertia is None else constant_inertia
+        spec = _check_spec(replace(spec, positions=positions))
+    _check_ode_args(rtol, None, samples, constant_inertia)
+    _require_count("max_iterations", max_iterations)
+    constant = _default_constant(mech, spec) if constant_inertia is None else float(constant_inertia)
     eq = _Equation(mech, spec, None, constant, samples)
     motor = eq.motor = _motor_of(spec, eq.cycle.driving)
     limit = _speed_limit(spec, motor)
@@ -648,35 +864,38 @@ def steady_state(mech: Mechanism, spec: DynamicsSpec | None = None, *, constant_
             raise DynamicsError(f"{name}: with the constant inertia {constant:.6g} kg m^2 the machine cannot "
                                 f"keep the mean speed {abs(spec.mean_speed):.6g} rad/s (it would stop "
                                 "within the cycle): add a flywheel")
-        energy0 = i0 * w[0] ** 2 / 2
+        energy0 = _kinetic_energy(i0, float(w[0]), name)
         # a constant moment other than the cycle's balancing one gains or loses energy every cycle
-        if abs(motor.moment - eq.cycle.driving) > 1e-6 * max(eq.scale, 1e-300):
+        if abs(motor.moment - eq.cycle.driving) > 1e-6 * eq.scale:
             raise DynamicsError(f"{name}: the constant driving moment {motor.moment:.6g} N m does not "
                                 f"balance the cycle's resistance ({eq.cycle.driving:.6g} N m needed): no "
                                 "periodic steady state")
     else:
         guess = motor.balance_speed(eq.cycle.driving)
-        if guess is None or not guess > 0:
+        if guess is None or not (math.isfinite(guess) and guess > 0):
             raise DynamicsError(f"{name}: the motor cannot deliver the mean moment {eq.cycle.driving:.6g} N m "
                                 "the cycle needs: the machine would stall")
-        energy0 = i0 * guess**2 / 2
+        energy0 = _kinetic_energy(i0, guess, name)
         for _ in range(3):  # let the start settle towards the attracting cycle
-            energy0 = float(one_cycle(energy0).y[0][-1])
+            energy0 = energy0 + float(one_cycle(energy0).y[0][-1])
         values: dict[float, float] = {}
 
-        def f(e0: float) -> float:
+        def f(e0: float) -> float:  # the energy gained over one cycle (the state is T - e0)
             if e0 not in values:
-                values[e0] = float(one_cycle(e0).y[0][-1]) - e0
+                values[e0] = float(one_cycle(e0).y[0][-1])
             return values[e0]
 
         lo, hi = energy0 * 0.9, energy0 * 1.1
         for _ in range(max_iterations):
-            if f(lo) * f(hi) <= 0:
+            if _opposite(f(lo), f(hi)):
                 break
             lo, hi = lo * 0.8, hi * 1.25
         else:
             raise DynamicsError(f"{name}: no periodic solution found near |omega| = {guess:.6g} rad/s")
-        energy0 = brentq(f, lo, hi, xtol=10 * rtol * energy0, rtol=10 * rtol, maxiter=100)
+        try:
+            energy0 = brentq(f, lo, hi, xtol=10 * rtol * energy0, rtol=10 * rtol, maxiter=100)
+        except RuntimeError as exc:  # not converged in maxiter
+            raise DynamicsError(f"{name}: the shooting for the periodic solution did not converge ({exc})") from None
     sol = one_cycle(energy0)
     n = spec.positions
     phi, ends = _cycle(mech, spec, n)
@@ -704,12 +923,14 @@ def steady_state(mech: Mechanism, spec: DynamicsSpec | None = None, *, constant_
 @dataclass(frozen=True)
 class DynamicsReport:
     """The course pipeline's results: the law of motion, reactions under the real motion and the
-    coefficient of dynamics."""
+    coefficient of dynamics ``k_dyn = max|M_b| / |M_d|`` (None, with a note, when the cycle's mean
+    driving moment on a fine grid is zero to within :data:`MEAN_MOMENT_RESOLVED` of the machine's
+    moment scale: a cycle that needs no net drive has no such ratio)."""
 
     mechanism: Mechanism
     law: LawOfMotion
     balancing_moment: np.ndarray
-    dynamic_coefficient: float
+    dynamic_coefficient: float | None
     comparison: dict
     notes: tuple[str, ...] = ()
 
@@ -729,7 +950,8 @@ class DynamicsReport:
         }
 
     def summary(self) -> dict[str, Any]:
-        """The scalar results (JSON keys of ``linkage dynamics``)."""
+        """The scalar results (JSON keys of ``linkage dynamics``); ``dynamic_coefficient`` is None
+        (JSON null) when the cycle needs no net drive (see :class:`DynamicsReport`)."""
         law = self.law
         return {
             "method": law.method,
@@ -757,18 +979,30 @@ def run_dynamics(mech: Mechanism, method: str = "course", *, positions: int | No
     positions, delta, mean_speed
         Override the declared inputs (mean speed in rad/s, signed).
     compare : bool
-        Also run the exact method next to the course method and report how far apart they are.
+        Also run the exact method next to the course method and report how far apart they are
+        (left out, with a note, when ``delta`` is below :data:`DELTA_RESOLVED`).
+
+    Raises
+    ------
+    DynamicsInputError
+        An unknown ``method`` or an argument out of range (see :func:`course_method`).
+    DynamicsError
+        See the method's function.
     """
     if method not in ("course", "exact", "ode"):
-        raise ValueError(f"method must be 'course', 'exact' or 'ode', got {method!r}")
-    spec = _override(mech, None, delta, mean_speed)
-    if positions is not None:
-        spec = replace(spec, positions=positions)
+        raise DynamicsInputError(f"method must be 'course', 'exact' or 'ode', got {method!r}")
+    spec = _override(mech, None, delta, mean_speed, positions)
     comparison: dict[str, Any] = {}
+    notes: tuple[str, ...] = ()
+    needed = None  # the cycle's mean driving moment on the fine grid (decides whether k_dyn exists)
     if method == "course":
         law = course_method(mech, spec)
-        if compare:
+        if compare and spec.delta < DELTA_RESOLVED:
+            notes += (f"delta = {spec.delta:.3g} is below what the exact method resolves ({DELTA_RESOLVED:g}): "
+                      "no comparison with it",)
+        elif compare:
             exact = exact_method(mech, spec)
+            needed = exact.driving_moment
             comparison = {
                 "exact_required_constant_inertia": exact.required_constant_inertia,
                 "exact_flywheel_inertia": exact.flywheel_inertia,
@@ -777,17 +1011,37 @@ def run_dynamics(mech: Mechanism, method: str = "course", *, positions: int | No
             }
     elif method == "exact":
         law = exact_method(mech, spec)
+        needed = law.driving_moment
     else:
         sized = exact_method(mech, spec) if spec.delta is not None else None
         law = steady_state(mech, spec, constant_inertia=sized and sized.constant_inertia)
+        needed = sized and sized.driving_moment
         if spec.initial_speed is not None:
             comparison = _settling(mech, spec, law)
+    if needed is None:
+        needed = _fine_cycle(mech, spec, _FINE_SAMPLES).driving
     _, ends = _cycle(mech, spec)
     motion = analyze(mech, law.phi, order=2, omega=law.omega, eps=law.eps)
     reactions = solve_reactions(motion, ends=ends)
-    k_dyn = float(np.max(np.abs(reactions.balancing_moment)) / abs(law.driving_moment)) \
-        if law.driving_moment != 0 else float("inf")
-    return DynamicsReport(mech, law, reactions.balancing_moment, k_dyn, comparison, reactions.notes)
+    k_dyn, k_notes = _dynamic_coefficient(law, reactions.balancing_moment, needed)
+    return DynamicsReport(mech, law, reactions.balancing_moment, k_dyn, comparison,
+                          reactions.notes + notes + k_notes)
+
+
+def _dynamic_coefficient(law: LawOfMotion, balancing: np.ndarray, needed: float) -> tuple[float | None,
+                                                                                      tuple[str, ...]]:
+    """``k_dyn = max|M_b| / |M_d|`` with the law's ``M_d``; None and a note when the cycle needs no
+    net drive: its mean driving moment on the fine grid (``needed``, free of the quadrature error
+    of a few table positions) is at most :data:`MEAN_MOMENT_RESOLVED` of the machine's moment
+    scale (the largest ``|M_b|`` and ``|M_red|`` over the cycle)."""
+    peak = float(np.max(np.abs(balancing)))
+    scale = max(peak, float(np.max(np.abs(law.reduced.moment))))
+    if abs(needed) > MEAN_MOMENT_RESOLVED * scale and law.driving_moment != 0:
+        return peak / abs(law.driving_moment), ()
+    return None, (f"coefficient of dynamics undefined: the mean driving moment ({needed:.3g} N m on a fine "
+                  f"grid, {law.driving_moment:.3g} N m by the {law.method} method) is zero within "
+                  f"{MEAN_MOMENT_RESOLVED:g} of the machine's moment scale ({scale:.3g} N m): the cycle needs "
+                  "no net drive",)
 
 
 def _settling(mech: Mechanism, spec: DynamicsSpec, law: LawOfMotion) -> dict[str, Any]:

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import brentq
 
+from .errors import InputError
 from .kinematics import _cache, analyze
 from .model import Mechanism
 
@@ -59,7 +60,7 @@ def _output_quantity(mech: Mechanism, quantity: str | None) -> str:
     if quantity is not None:
         return quantity
     if mech.output is None:
-        raise ValueError(f"mechanism '{mech.name}' declares no output: name the quantity (e.g. 'B.x')")
+        raise InputError(f"mechanism '{mech.name}' declares no output: name the quantity (e.g. 'B.x')")
     return mech.output.quantity
 
 
@@ -79,8 +80,8 @@ def extreme_positions(mech: Mechanism, quantity: str | None = None, *, samples: 
 
     Raises
     ------
-    ValueError
-        When the quantity has no extreme position over a revolution (it is monotonic or constant).
+    InputError
+        (a ``ValueError``) When the quantity has no extreme position over a revolution (it is monotonic or constant).
     """
     quantity = _output_quantity(mech, quantity)
     key = ("extremes", quantity, samples, xtol)
@@ -98,9 +99,10 @@ def _find_extremes(mech: Mechanism, quantity: str, samples: int, xtol: float) ->
     motion = analyze(mech, grid, order=1, outputs=[quantity], on_failure="mask")
     d1 = motion.quantity(quantity)[1]
     if not np.isfinite(d1).any():
-        raise ValueError(f"mechanism '{mech.name}' cannot be assembled at any input angle")
-    if not np.nanmax(np.abs(d1)) > 1e-12 * mech.size:
-        raise ValueError(f"'{quantity}' of mechanism '{mech.name}' does not move: it has no extreme "
+        raise InputError(f"mechanism '{mech.name}' cannot be assembled at any input angle")
+    scale = 1.0 if quantity.endswith(".theta") else mech.size  # an angle's analog is in rad/rad
+    if not np.nanmax(np.abs(d1)) > 1e-12 * scale:
+        raise InputError(f"'{quantity}' of mechanism '{mech.name}' does not move: it has no extreme "
                          "positions")
     step = 2 * np.pi / samples
     following = np.roll(d1, -1)  # cyclic: the last interval closes the revolution at 2 pi
@@ -109,7 +111,7 @@ def _find_extremes(mech: Mechanism, quantity: str, samples: int, xtol: float) ->
     for i in np.flatnonzero(valid & (d1 * following < 0)):
         roots.append(brentq(derivative, grid[i], grid[i] + step, xtol=xtol, rtol=4 * np.finfo(float).eps))
     if not roots:
-        raise ValueError(f"'{quantity}' of mechanism '{mech.name}' has no extreme position: its first "
+        raise InputError(f"'{quantity}' of mechanism '{mech.name}' has no extreme position: its first "
                          "analog does not change sign over a revolution")
     roots = np.mod(roots, 2 * np.pi)
     roots = np.unique(np.where(roots > 2 * np.pi - 1e-12, 0.0, roots))
@@ -137,12 +139,12 @@ def table_angles(mech: Mechanism, n: int = 12, start: str | float = "extreme", d
         Sign of the input angular velocity (the order of positions).
     """
     if n < 1:
-        raise ValueError(f"the number of positions must be >= 1, got {n}")
+        raise InputError(f"the number of positions must be >= 1, got {n}")
     if direction not in (1, -1):
-        raise ValueError(f"direction must be +1 or -1, got {direction!r}")
+        raise InputError(f"direction must be +1 or -1, got {direction!r}")
     if isinstance(start, str):
         if start not in ("extreme", "max", "min"):
-            raise ValueError(f"start must be 'extreme', 'max', 'min' or an angle in deg, got {start!r}")
+            raise InputError(f"start must be 'extreme', 'max', 'min' or an angle in deg, got {start!r}")
         which = start if start != "extreme" else (mech.output.start if mech.output else "max")
         ext = extreme_positions(mech, quantity)
         phi0 = ext.phi_max if which == "max" else ext.phi_min

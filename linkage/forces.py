@@ -27,16 +27,17 @@ Declared in scheme files as::
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any, Mapping, Sequence
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .extremes import extreme_positions, wrap_angle
+from .errors import InputError, LinkageError, SchemeError
+from .extremes import extreme_positions, table_angles, wrap_angle
 from .kinematics import Motion
-from .model import Mechanism, _is_number
-from .scheme import SECTION_VALIDATORS
+from .model import Mechanism, check_number, unknown_keys
+from .scheme import register_section, section_of
 
 __all__ = [
     "StrokeDiagram",
@@ -72,6 +73,12 @@ class StrokeDiagram:
     opposes : bool
         True (default): the load opposes the working motion (a useful resistance); False: it
         drives it.
+    idle_fractions, idle_values : sequence of float
+        The diagram of the idle stroke (fractions of the idle stroke from its start), if any.
+    stroke_ends : (float, float) or None
+        ``(value_min, value_max)`` of the quantity, its extreme values: found once when a scheme
+        is loaded (None: found from the mechanism's extreme positions when needed). Not part of
+        the diagram's identity (equality).
     """
 
     quantity: str
@@ -81,6 +88,7 @@ class StrokeDiagram:
     opposes: bool = True
     idle_fractions: tuple[float, ...] = ()
     idle_values: tuple[float, ...] = ()
+    stroke_ends: tuple[float, float] | None = field(default=None, compare=False)
 
     def magnitude(self, mech: Mechanism, value, first, second, rotation: float, ends=None):
         """Signed load along the quantity at positions with the given value and analogs.
@@ -88,8 +96,12 @@ class StrokeDiagram:
         At a stroke end the load is two-valued: a position counts in the stroke the mechanism
         enters (the sign of ``q''``, whatever the rotation), or in the one it leaves where ``ends`` is True.
         """
-        ext = extreme_positions(mech, self.quantity)
-        stroke = ext.value_max - ext.value_min
+        if self.stroke_ends is not None:
+            value_min, value_max = self.stroke_ends
+        else:
+            ext = extreme_positions(mech, self.quantity)
+            value_min, value_max = ext.value_min, ext.value_max
+        stroke = value_max - value_min
         moving = np.sign(first * rotation)  # direction of the output's motion in time
         at_end = np.abs(first) <= 1e-9 * stroke
         leaving = np.zeros(len(value), bool) if ends is None else np.asarray(ends, bool)
@@ -97,7 +109,7 @@ class StrokeDiagram:
         entering_dir = np.sign(second) * np.where(leaving, -1.0, 1.0)
         direction = np.where(at_end, entering_dir, moving)
         working = direction == self.working
-        start = ext.value_min if self.working > 0 else ext.value_max
+        start = value_min if self.working > 0 else value_max
         travel = value - start
         if self.quantity.endswith(".theta"):  # a link angle may cross the +-pi cut
             travel = wrap_angle(travel)
@@ -120,18 +132,19 @@ class CycleTable:
     Position 1 is the start of the cycle (``start``: "extreme", "max", "min" or degrees) and
     positions follow the rotation; between positions the value is linear in the cycle angle, and
     position n+1 (the cycle's end, same angle as position 1) may carry its own value.
+    ``phi0`` is the input angle of position 1 (rad): found once when a scheme is loaded (None:
+    found from ``start`` when needed); not part of the table's identity (equality).
     """
 
     quantity: str
     values: tuple[float, ...]
     start: Any = "extreme"
     rotation: int = 1
+    phi0: float | None = field(default=None, compare=False)
 
     def magnitude(self, mech: Mechanism, phi: np.ndarray, ends=None) -> np.ndarray:
-        from .extremes import table_angles
-
         n = len(self.values) - 1
-        phi0 = table_angles(mech, 1, self.start, self.rotation)[0]
+        phi0 = self.phi0 if self.phi0 is not None else table_angles(mech, 1, self.start, self.rotation)[0]
         psi = np.mod(self.rotation * (phi - phi0), 2 * np.pi)
         psi = np.where(np.isclose(psi, 2 * np.pi, rtol=0, atol=1e-9), 0.0, psi)
         if ends is not None:
@@ -195,107 +208,130 @@ class LoadTerm:
 # ----------------------------------------------------------------------------------------------
 
 
+def _numbers(raw: Any, where: str, what: str, problems: list[str], kind: str, unit: str = "",
+             length: int | None = None, at_least: int = 0) -> tuple[float, ...] | None:
+    """A list of numbers in the range ``kind`` (of ``length`` items, or ``at_least``); None with
+    one problem (naming the first bad item) otherwise."""
+    if not (isinstance(raw, list) and (len(raw) == length if length is not None else len(raw) >= at_least)):
+        size = f"{length}" if length is not None else f"at least {at_least}"
+        problems.append(f"{where}: {what} must be a list of {size} numbers, got {raw!r}")
+        return None
+    values = []
+    for i, x in enumerate(raw):
+        v = check_number(x, where, f"{what}[{i}]", problems, kind, unit)
+        if v is None:
+            return None
+        values.append(v)
+    return tuple(values)
+
+
 def _diagram(mech: Mechanism, raw: Any, quantity: str, where: str, problems: list[str]):
     if not isinstance(raw, Mapping):
         problems.append(f"{where}: diagram must be a table, got {raw!r}")
         return None
     known = {"along", "working", "fractions", "values", "opposes", "idle_fractions", "idle_values"}
-    bad = set(raw) - known
-    if bad:
-        problems.append(f"{where}: unknown diagram keys {sorted(bad)} (known: {sorted(known)})")
-    working = {"+": 1, "-": -1, 1: 1, -1: -1}.get(raw.get("working"))
+    if unknown_keys(raw, known, f"{where} diagram", problems):
+        return None
+    raw_working = raw.get("working")
+    working = {"+": 1, "-": -1, 1: 1, -1: -1}.get(raw_working) \
+        if isinstance(raw_working, (str, int)) and not isinstance(raw_working, bool) else None
     if working is None:
         problems.append(f"{where}: diagram 'working' must be \"+\" or \"-\" (the direction of "
-                        f"{quantity} on the working stroke), got {raw.get('working')!r}")
+                        f"{quantity} on the working stroke), got {raw_working!r}")
         return None
     curves = []
     for fk, vk in (("fractions", "values"), ("idle_fractions", "idle_values")):
-        fr, vals = raw.get(fk, []), raw.get(vk, [])
-        if fk == "idle_fractions" and not fr and not vals:
+        if fk == "idle_fractions" and fk not in raw and vk not in raw:
             curves.append(((), ()))
             continue
-        if not (isinstance(fr, list) and isinstance(vals, list) and len(fr) == len(vals) >= 2
-                and all(_is_number(x) for x in fr + vals)):
-            problems.append(f"{where}: diagram '{fk}' and '{vk}' must be lists of numbers of the same "
-                            f"length >= 2, got {fr!r} and {vals!r}")
+        fr = _numbers(raw.get(fk), where, f"diagram '{fk}'", problems, "fraction", at_least=2)
+        if fr is None:
+            return None
+        vals = _numbers(raw.get(vk), where, f"diagram '{vk}' (magnitudes: the sign comes from "
+                        "'opposes')", problems, "nonnegative", length=len(fr))
+        if vals is None:
             return None
         if fr[0] != 0 or fr[-1] != 1 or any(b <= a for a, b in zip(fr, fr[1:])):
             problems.append(f"{where}: diagram '{fk}' must increase from 0 to 1 (fractions of the "
-                            f"stroke), got {fr}")
+                            f"stroke), got {raw.get(fk)!r}")
             return None
-        if any(v < 0 for v in vals):
-            problems.append(f"{where}: diagram '{vk}' are magnitudes and must be >= 0 (the sign "
-                            f"comes from 'opposes'), got {vals}")
-            return None
-        curves.append((tuple(map(float, fr)), tuple(map(float, vals))))
+        curves.append((fr, vals))
     opposes = raw.get("opposes", True)
     if not isinstance(opposes, bool):
         problems.append(f"{where}: diagram 'opposes' must be true or false, got {opposes!r}")
         return None
-    diagram = StrokeDiagram(quantity, working, *curves[0], opposes, *curves[1])
     try:
         ext = extreme_positions(mech, quantity)
-    except ValueError as exc:
+    except (LinkageError, ValueError) as exc:
         problems.append(f"{where}: {exc}")
         return None
-    if ext.stroke <= 1e-9 * mech.size:
-        problems.append(f"{where}: the working direction {raw.get('working')!r} is never taken: "
+    if ext.stroke <= 1e-9 * (1.0 if quantity.endswith(".theta") else mech.size):  # rad or m
+        problems.append(f"{where}: the working direction {raw_working!r} is never taken: "
                         f"{quantity} does not move (stroke {ext.stroke:.3g})")
         return None
-    return diagram
+    return StrokeDiagram(quantity, working, *curves[0], opposes, *curves[1],
+                         stroke_ends=(ext.value_min, ext.value_max))
 
 
 def _cycle_table(mech: Mechanism, spec, point: str, where: str, problems: list[str]):
     """A :class:`CycleTable` from ``cycle = [...]`` and ``along``; the cycle (start, rotation) is
     the one the mechanism's ``[dynamics]`` declares."""
-    along, values = spec.get("along"), spec.get("cycle")
+    along = spec.get("along")
     if along not in ("x", "y"):
         problems.append(f"{where}: a cycle table needs along = \"x\" or \"y\", got {along!r}")
         return None
-    if not (isinstance(values, list) and len(values) >= 3 and all(_is_number(v) for v in values)):
-        problems.append(f"{where}: cycle must list the values (N) at positions 1..n+1, got {values!r}")
+    values = _numbers(spec.get("cycle"), where, "cycle (the values, N, at positions 1..n+1)", problems,
+                      "real", "N", at_least=3)
+    if values is None:
         return None
-    dyn = mech.extra.get("dynamics")
-    speed = dyn.get("mean_speed", dyn.get("mean_rpm")) if isinstance(dyn, Mapping) else None
-    if not _is_number(speed) or speed == 0:
+    try:
+        dyn = section_of(mech, "dynamics")
+    except SchemeError:  # the [dynamics] section's own problems are reported with it
+        return None
+    if dyn is None:
         problems.append(f"{where}: a cycle table needs the direction of rotation: declare [dynamics] "
                         "mean_speed (rad/s) or mean_rpm, signed")
         return None
-    start = dyn.get("start_deg", "extreme")
-    return CycleTable(f"{point}.{along}", tuple(float(v) for v in values), start, int(np.sign(speed)))
+    try:
+        phi0 = float(table_angles(mech, 1, dyn.start, dyn.rotation)[0])
+    except (LinkageError, ValueError) as exc:
+        problems.append(f"{where}: the cycle's first position: {exc}")
+        return None
+    return CycleTable(f"{point}.{along}", values, dyn.start, dyn.rotation, phi0)
 
 
-def _vector_or_none(raw):
-    if isinstance(raw, list) and len(raw) == 2 and all(_is_number(v) for v in raw):
-        return (float(raw[0]), float(raw[1]))
-    return None
+def _entries(raw: Mapping[str, Any], key: str, problems: list[str]) -> list:
+    """The array of tables ``[[loads.<key>]]`` (empty with a problem when it is not one)."""
+    entries = raw.get(key, [])
+    if not isinstance(entries, list):
+        problems.append(f"{key}: expected an array of tables ([[loads.{key}]]), got {entries!r}")
+        return []
+    return entries
 
 
 def parse_loads(mech: Mechanism, raw: Mapping[str, Any] | None) -> tuple[Loads, list[str]]:
-    """Loads and the list of problems from a scheme's ``[loads]`` table."""
+    """Loads and the list of problems from a scheme's ``[loads]`` table.
+
+    Every number is checked against its range (``schemes/README.md``, "Ranges"); the stroke ends
+    of force diagrams and the first position of cycle tables are found here, once.
+    """
     problems: list[str] = []
-    raw = raw or {}
+    raw = {} if raw is None else raw
     if not isinstance(raw, Mapping):
         return Loads(), [f"expected a table, got {raw!r}"]
-    bad = set(raw) - {"gravity", "forces", "moments"}
-    if bad:
-        problems.append(f"unknown keys {sorted(bad)} (known: ['forces', 'gravity', 'moments'])")
+    unknown_keys(raw, {"gravity", "forces", "moments"}, "", problems)
     gravity = STANDARD_GRAVITY
     if "gravity" in raw:
-        g = _vector_or_none(raw["gravity"])
-        if g is None:
-            problems.append(f"gravity must be [gx, gy] in m/s^2, got {raw['gravity']!r}")
-        else:
-            gravity = g
+        g = _numbers(raw["gravity"], "gravity", "[gx, gy]", problems, "real", "m/s^2", length=2)
+        gravity = g if g is not None else gravity
     forces, moments = [], []
-    for i, spec in enumerate(raw.get("forces", [])):
+    for i, spec in enumerate(_entries(raw, "forces", problems)):
         where = f"forces[{i}]"
         if not isinstance(spec, Mapping):
             problems.append(f"{where}: expected a table, got {spec!r}")
             continue
-        bad = set(spec) - {"point", "link", "force", "diagram", "cycle", "along"}
-        if bad:
-            problems.append(f"{where}: unknown keys {sorted(bad)}")
+        if unknown_keys(spec, {"point", "link", "force", "diagram", "cycle", "along"}, where, problems):
+            continue
         point = spec.get("point")
         where = f"forces[{i}] (point {point!r})"
         owners = [k for k in mech.point_links(point) if k != mech.frame] if isinstance(point, str) else []
@@ -322,11 +358,9 @@ def parse_loads(mech: Mechanism, raw: Mapping[str, Any] | None) -> tuple[Loads, 
             if table is not None:
                 forces.append(PointForce(point, link, table))
         elif "force" in spec:
-            vec = _vector_or_none(spec["force"])
-            if vec is None:
-                problems.append(f"{where}: force must be [Fx, Fy] in N, got {spec['force']!r}")
-                continue
-            forces.append(PointForce(point, link, vec))
+            vec = _numbers(spec["force"], where, "force [Fx, Fy]", problems, "real", "N", length=2)
+            if vec is not None:
+                forces.append(PointForce(point, link, vec))
         else:
             along = spec["diagram"].get("along") if isinstance(spec["diagram"], Mapping) else None
             if along not in ("x", "y"):
@@ -335,16 +369,15 @@ def parse_loads(mech: Mechanism, raw: Mapping[str, Any] | None) -> tuple[Loads, 
             d = _diagram(mech, spec["diagram"], f"{point}.{along}", where, problems)
             if d is not None:
                 forces.append(PointForce(point, link, d))
-    for i, spec in enumerate(raw.get("moments", [])):
+    for i, spec in enumerate(_entries(raw, "moments", problems)):
         where = f"moments[{i}]"
         if not isinstance(spec, Mapping):
             problems.append(f"{where}: expected a table, got {spec!r}")
             continue
         link = spec.get("link")
         where = f"moments[{i}] (link {link!r})"
-        if set(spec) - {"link", "moment", "diagram"}:
-            problems.append(f"{where}: unknown keys {sorted(set(spec) - {'link', 'moment', 'diagram'})} "
-                            "(known: ['diagram', 'link', 'moment'])")
+        if unknown_keys(spec, {"link", "moment", "diagram"}, where, problems):
+            continue
         if link not in mech.moving_links:
             problems.append(f"{where}: unknown moving link {link!r} (moving links: {mech.moving_links})")
             continue
@@ -352,10 +385,9 @@ def parse_loads(mech: Mechanism, raw: Mapping[str, Any] | None) -> tuple[Loads, 
             problems.append(f"{where}: give exactly one of 'moment' (N m) or 'diagram' = {{...}}")
             continue
         if "moment" in spec:
-            if not _is_number(spec["moment"]):
-                problems.append(f"{where}: moment must be a number (N m), got {spec['moment']!r}")
-                continue
-            moments.append(LinkMoment(link, float(spec["moment"])))
+            value = check_number(spec["moment"], where, "moment", problems, "real", "N m")
+            if value is not None:
+                moments.append(LinkMoment(link, value))
         else:
             d = _diagram(mech, spec["diagram"], f"{link}.theta", where, problems)
             if d is not None:
@@ -366,16 +398,19 @@ def parse_loads(mech: Mechanism, raw: Mapping[str, Any] | None) -> tuple[Loads, 
 
 
 def loads_of(mech: Mechanism) -> Loads:
-    """The loads a mechanism declares (``[loads]`` of its scheme; gravity alone by default)."""
-    loads, problems = parse_loads(mech, mech.extra.get("loads"))
-    if problems:
-        from .errors import SchemeError
+    """The loads a mechanism declares (``[loads]`` of its scheme; gravity alone by default).
 
-        raise SchemeError([f"mechanism '{mech.name}' loads: {p}" for p in problems])
-    return loads
+    Parsed once (when the scheme is loaded, or on first use) and kept on the mechanism.
+
+    Raises
+    ------
+    SchemeError
+        When the mechanism's ``[loads]`` (or the ``[dynamics]`` it reads) is declared wrongly.
+    """
+    return section_of(mech, "loads")
 
 
-SECTION_VALIDATORS["loads"] = lambda mech, raw: parse_loads(mech, raw)[1]
+register_section("loads", parse_loads, requires=("dynamics",))
 
 
 # ----------------------------------------------------------------------------------------------
@@ -388,7 +423,7 @@ def _per_position(value: ArrayLike, n: int, shape: tuple[int, ...], what: str) -
     try:
         return np.broadcast_to(arr, (n, *shape)).copy()
     except ValueError:
-        raise ValueError(f"{what}: expected a constant of shape {shape} or per-position values of "
+        raise InputError(f"{what}: expected a constant of shape {shape} or per-position values of "
                          f"shape {(n, *shape)}, got shape {arr.shape}") from None
 
 
@@ -442,7 +477,7 @@ def inertia_terms(motion: Motion) -> list[LoadTerm]:
     Needs a motion analysed with ``omega`` (and ``eps``) and second analogs.
     """
     if motion.omega is None or motion.second is None:
-        raise ValueError("inertia loads need real accelerations: analyze(..., order=2, omega=..., eps=...)")
+        raise InputError("inertia loads need real accelerations: analyze(..., order=2, omega=..., eps=...)")
     from assur.base import point_analogs
 
     mech = motion.mechanism

@@ -43,6 +43,7 @@ __all__ = [
     "MAX_MAGNITUDE",
     "MIN_MAGNITUDE",
     "MAX_ANGLE_DEG",
+    "MAX_POSITIONS",
     "check_number",
     "unknown_keys",
 ]
@@ -282,6 +283,10 @@ MIN_MAGNITUDE = 1e-50
 #: 1e-10 of a degree (its spacing at 1e6 is 1.2e-10).
 MAX_ANGLE_DEG = 1e6
 
+#: Largest number of positions per revolution of a table (and of table positions a scheme's
+#: ``[dynamics]`` may declare): the arrays grow with it.
+MAX_POSITIONS = 100_000
+
 _RANGES = {
     # kind: (test, description)
     "real": (lambda v: abs(v) <= MAX_MAGNITUDE, f"a number with |x| <= {MAX_MAGNITUDE:g}"),
@@ -351,7 +356,7 @@ def unknown_keys(spec: Mapping[str, Any], known, where: str, problems: list[str]
     if not bad:
         return set()
     absent = sorted(k for k in known if k not in spec)
-    meant = [m[0] for m in (difflib.get_close_matches(str(k), absent, n=1, cutoff=0.75) for k in bad) if m]
+    meant = [m[0] for m in (difflib.get_close_matches(str(k), absent, n=1, cutoff=0.6) for k in bad) if m]
     hint = f"; did you mean {', '.join(repr(m) for m in meant)}?" if meant else ""
     problems.append(f"{where + ': ' if where else ''}unknown keys {bad} (known: {sorted(known)}){hint}")
     return set(meant)
@@ -413,8 +418,10 @@ class MechanismBuilder:
         self._assembly: list[Assembly] = []
         self._output: Output | None = None
         self._problems: list[str] = []
-        self._rejected: set[str] = set()
-        self._unplaced: dict[str, set[str]] = {}
+        self._rejected: set[str] = set()  # links and pairs refused (reported already)
+        self._unplaced: dict[str, set[str]] = {}  # link -> its points and guides refused
+        self._incomplete: set[str] = set()  # links whose refused line leaves its points unknown
+        self._inputs_refused = False
 
     # -- links ---------------------------------------------------------------------------------
     def link(
@@ -457,6 +464,7 @@ class MechanismBuilder:
         if line is not None or length is not None:
             if not isinstance(line, (tuple, list)) or len(line) != 2 or not all(isinstance(s, str) for s in line):
                 p.append(f"{where}: 'line' must name two points, got {line!r}")
+                self._incomplete.add(name)  # its points are unknown: no follow-ons about them
             elif line[0] == line[1]:
                 p.append(f"{where}: 'line' joins point '{line[0]}' to itself")
                 unplaced.add(line[0])
@@ -467,13 +475,15 @@ class MechanismBuilder:
                 else:
                     local[line[0]] = (0.0, 0.0)
                     local[line[1]] = (value, 0.0)
+        # names whose absence is reported already: refused ones (or all, when the line is unknown)
+        missing = _EVERY_NAME if name in self._incomplete else unplaced
         for pname, spec in (points or {}).items():
             pwhere = f"{where} point '{pname}'"
             if pname in local:
                 p.append(f"{pwhere}: declared twice")
                 continue
             if isinstance(spec, Mapping):
-                vec = self._relative_point(spec, local, unplaced, pwhere)
+                vec = self._relative_point(spec, local, missing, pwhere)
             else:
                 vec = _coordinates(spec, pwhere, "[x, y] or {from, distance, angle_deg}", p)
             if vec is None:
@@ -483,7 +493,7 @@ class MechanismBuilder:
         link_guides: dict[str, Guide] = {}
         for gname, spec in (guides or {}).items():
             gwhere = f"{where} guide '{gname}'"
-            guide = self._guide(spec, local, unplaced, gwhere)
+            guide = self._guide(spec, local, missing, gwhere)
             if guide is None:
                 unplaced.add(gname)
             else:
@@ -495,7 +505,7 @@ class MechanismBuilder:
         if isinstance(com, str):
             if com in local:
                 center = local[com]
-            elif com not in unplaced:
+            elif com not in missing:
                 p.append(f"{where}: centre of mass must be a point of the link or [x, y], got {com!r}")
         elif com is not None:
             center = _coordinates(com, where + " centre of mass", "a point of the link or [x, y]", p) or center
@@ -512,8 +522,7 @@ class MechanismBuilder:
         )
         return self
 
-    def _relative_point(self, spec: Mapping[str, Any], local: dict[str, Vec], unplaced: set[str],
-                        where: str) -> Vec | None:
+    def _relative_point(self, spec: Mapping[str, Any], local: dict[str, Vec], unplaced, where: str) -> Vec | None:
         p = self._problems
         unknown_keys(spec, {"from", "distance", "angle", "angle_deg"}, where, p)
         origin = spec.get("from")
@@ -528,7 +537,7 @@ class MechanismBuilder:
         ox, oy = local[origin]
         return (ox + distance * math.cos(angle), oy + distance * math.sin(angle))
 
-    def _guide(self, spec: Any, local: dict[str, Vec], unplaced: set[str], where: str) -> Guide | None:
+    def _guide(self, spec: Any, local: dict[str, Vec], unplaced, where: str) -> Guide | None:
         p = self._problems
         if not isinstance(spec, Mapping):
             p.append(f"{where}: expected {{through, angle_deg, offset}}, got {spec!r}")
@@ -569,16 +578,18 @@ class MechanismBuilder:
             self._pairs[name] = Prismatic(name, (guide_link, slider_link), guide, at, value)
         return self
 
-    def reject(self, name: str, names=()) -> "MechanismBuilder":
-        """Note that the declaration of the link or pair ``name`` was refused by the caller, who
-        has reported why (a misspelt key in a scheme file, say).
+    def reject(self, name: str | None = None, names=(), *, inputs: bool = False) -> "MechanismBuilder":
+        """Note that a declaration was refused by the caller, who has reported why (a misspelt key
+        in a scheme file, say): the link or pair ``name`` (with the points and guides ``names`` it
+        declares), or, with ``inputs``, the input links.
 
         :meth:`build` then leaves out the problems that only follow from its absence (pairs that
-        join it, the points and guides ``names`` it declares, the input's frame pair): one message
-        per root cause.
+        join it, its points, the input's frame pair, "no input link"): one message per root cause.
         """
-        self._rejected.add(name)
-        self._unplaced.setdefault(name, set()).update(n for n in names if isinstance(n, str))
+        if name is not None:
+            self._rejected.add(name)
+            self._unplaced.setdefault(name, set()).update(n for n in names if isinstance(n, str))
+        self._inputs_refused = self._inputs_refused or inputs
         return self
 
     def _check_pair_name(self, name: str) -> bool:
@@ -667,13 +678,30 @@ class MechanismBuilder:
             self.description,
             dict(extra),
         )
-        problems = self._problems + validate(mech, self._rejected, self._unplaced)
+        refused = dict(self._unplaced)
+        for name in self._incomplete:
+            refused[name] = _EVERY_NAME
+        problems = self._problems + validate(mech, self._rejected, refused, inputs_refused=self._inputs_refused)
         if problems:
             raise SchemeError(problems)
         return mech
 
 
-def validate(mech: Mechanism, rejected=frozenset(), unplaced: Mapping[str, set] | None = None) -> list[str]:
+class _EveryName:
+    """The points of a link whose declaration left them unknown: contains every name."""
+
+    def __contains__(self, name) -> bool:
+        return True
+
+    def __iter__(self):
+        return iter(())
+
+
+_EVERY_NAME = _EveryName()
+
+
+def validate(mech: Mechanism, rejected=frozenset(), unplaced: Mapping[str, set] | None = None, *,
+             inputs_refused: bool = False) -> list[str]:
     """Every problem of a mechanism's declaration (empty when it is sound).
 
     Parameters
@@ -684,6 +712,8 @@ def validate(mech: Mechanism, rejected=frozenset(), unplaced: Mapping[str, set] 
         follow from their absence are left out.
     unplaced : dict of link -> set of str
         Points and guides of a link whose declarations were refused (already reported).
+    inputs_refused : bool
+        The declaration of the input links was refused (already reported).
     """
     p: list[str] = []
     links = mech.links
@@ -708,6 +738,10 @@ def validate(mech: Mechanism, rejected=frozenset(), unplaced: Mapping[str, set] 
             for x in (a, b):
                 if pair.point not in links[x].points and not refused(x, pair.point):
                     p.append(f"{where}: point '{pair.point}' is not declared on link '{x}'")
+        elif (pair.guide not in links[a].guides and pair.point not in links[b].points
+              and pair.guide in links[b].guides and pair.point in links[a].points):
+            p.append(f"{where}: links {list(pair.links)} are in the wrong order: a prismatic pair's links "
+                     f"are [guide link, slider link], and guide '{pair.guide}' is on link '{b}'")
         else:
             if pair.guide not in links[a].guides and not refused(a, pair.guide):
                 p.append(f"{where}: link '{a}' has no guide '{pair.guide}' "
@@ -717,7 +751,7 @@ def validate(mech: Mechanism, rejected=frozenset(), unplaced: Mapping[str, set] 
     clash = sorted(set(mech.pairs) & set(links))
     for name in clash:
         p.append(f"name '{name}' is used for both a link and a pair")
-    if not mech.inputs:
+    if not mech.inputs and not inputs_refused:
         p.append("no input link declared (input = \"<link>\")")
     if len(set(mech.inputs)) != len(mech.inputs):
         p.append(f"input links declared twice: {list(mech.inputs)}")

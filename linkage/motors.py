@@ -30,6 +30,9 @@ class ConstantMotor:
 
     moment: float
 
+    def __post_init__(self):
+        _check(self, moment="finite")
+
     def __call__(self, w):
         return np.full_like(np.asarray(w, dtype=float), self.moment)
 
@@ -46,6 +49,9 @@ class LinearMotor:
     no_load_speed: float
     ratio: float = 1.0
     efficiency: float = 1.0
+
+    def __post_init__(self):
+        _check(self, stall_moment="finite", no_load_speed="> 0", ratio="> 0", efficiency="(0, 1]")
 
     def __call__(self, w):
         wm = self.ratio * np.asarray(w, dtype=float)
@@ -64,6 +70,10 @@ class InductionMotor:
     ``S = (n_s - n) / n_s`` is the slip, ``M_k = overload * rated_moment`` the breakdown moment
     and ``S_k = S_nom (overload + sqrt(overload^2 - 1))`` the breakdown slip from the rated slip.
     Speeds in rpm on the motor shaft.
+
+    The characteristic is evaluated as ``M = 2 M_nom (lambda x) / (1 + x^2)`` with ``x = S / S_k``
+    and ``lambda x = S / (S_nom (1 + sqrt(1 - 1/lambda^2)))``: the same function, finite for any
+    finite overload ``lambda > 1`` (for a huge one it tends to the linear ``M_nom S / S_nom``).
     """
 
     rated_moment: float
@@ -73,32 +83,72 @@ class InductionMotor:
     ratio: float = 1.0
     efficiency: float = 1.0
 
+    def __post_init__(self):
+        _check(self, rated_moment="> 0", synchronous_rpm="> 0", rated_rpm="> 0", overload="> 1", ratio="> 0",
+               efficiency="(0, 1]")
+        if not self.rated_rpm < self.synchronous_rpm:
+            _fail(f"InductionMotor: rated_rpm must be below synchronous_rpm ({self.synchronous_rpm!r}), got "
+                  f"{self.rated_rpm!r}")
+
+    @property
+    def _slip_per_overload(self) -> float:
+        """``S_k / overload = S_nom (1 + sqrt(1 - 1/overload^2))``, finite for any overload."""
+        rated_slip = (self.synchronous_rpm - self.rated_rpm) / self.synchronous_rpm
+        r = 1.0 / self.overload
+        return rated_slip * (1.0 + math.sqrt(1.0 - r * r))
+
     @property
     def breakdown_slip(self) -> float:
-        rated_slip = (self.synchronous_rpm - self.rated_rpm) / self.synchronous_rpm
-        lam = self.overload
-        return rated_slip * (lam + math.sqrt(lam * lam - 1.0))
+        return self.overload * self._slip_per_overload
 
     def __call__(self, w):
         n = self.ratio * np.asarray(w, dtype=float) / RPM
         slip = (self.synchronous_rpm - n) / self.synchronous_rpm
-        sk = self.breakdown_slip
-        m_motor = 2 * self.overload * self.rated_moment * slip * sk / (slip**2 + sk**2)
+        lam_x = slip / self._slip_per_overload  # overload * S / S_k
+        x = lam_x / self.overload  # S / S_k
+        m_motor = 2 * self.rated_moment * lam_x / (1 + x * x)
         return self.ratio * self.efficiency * m_motor
 
     def balance_speed(self, moment: float) -> float | None:
         """Input speed on the stable branch (slip < S_k) where the reduced moment is ``moment``."""
-        m = moment / (self.ratio * self.efficiency)
-        mk, sk = self.overload * self.rated_moment, self.breakdown_slip
-        if m >= mk:
+        m = moment / (self.ratio * self.efficiency) / self.rated_moment  # in rated moments
+        if m >= self.overload:
             return None
-        # m (S^2 + sk^2) = 2 mk sk S -> S = sk (mk - sqrt(mk^2 - m^2)) / m
-        slip = sk * (mk - math.sqrt(mk * mk - m * m)) / m if m > 0 else 0.0
+        # m (S^2 + sk^2) = 2 mk sk S -> S = sk (mk - sqrt(mk^2 - m^2)) / m = sk mu / (1 + sqrt(1 - mu^2))
+        # with mu = m / mk, and sk mu = (S_k / overload) m: no overflow for any overload
+        mu = m / self.overload
+        slip = self._slip_per_overload * m / (1.0 + math.sqrt(1.0 - mu * mu)) if m > 0 else 0.0
         return self.synchronous_rpm * (1 - slip) * RPM / self.ratio
 
 
+def _fail(message: str) -> None:
+    from .dynamics import DynamicsInputError  # late: dynamics imports this module
+
+    raise DynamicsInputError(message)
+
+
+def _check(motor: Any, **rules: str) -> None:
+    """DynamicsInputError naming the first parameter of ``motor`` that breaks its rule
+    ("finite", "> 0", "> 1" or "(0, 1]"; every rule implies a finite real number)."""
+    tests = {"finite": lambda v: True, "> 0": lambda v: v > 0, "> 1": lambda v: v > 1,
+             "(0, 1]": lambda v: 0 < v <= 1}
+    for name, rule in rules.items():
+        v = getattr(motor, name)
+        real = isinstance(v, (int, float, np.integer, np.floating)) and not isinstance(v, (bool, np.bool_))
+        if not (real and math.isfinite(v) and tests[rule](v)):
+            _fail(f"{type(motor).__name__}: {name} must be {'a finite number' if rule == 'finite' else rule}, "
+                  f"got {v!r}")
+
+
 def motor_from_spec(spec: Mapping[str, Any]) -> tuple[Any | None, list[str]]:
-    """A motor and the list of problems from a scheme's ``[dynamics.motor]`` table."""
+    """A motor and the list of problems from a scheme's ``[dynamics.motor]`` table.
+
+    Every number is checked against its range (``schemes/README.md``, "Ranges"): moments within
+    1e50 in magnitude, speeds, ratios, rated power and moment in [1e-50, 1e50], efficiency in
+    (0, 1], overload in (1, 1e50], rated_rpm below synchronous_rpm.
+    """
+    from .model import check_number, unknown_keys  # late: keep this module free of the model
+
     if not isinstance(spec, Mapping):
         return None, [f"motor: expected a table, got {spec!r}"]
     kind = spec.get("kind")
@@ -108,36 +158,46 @@ def motor_from_spec(spec: Mapping[str, Any]) -> tuple[Any | None, list[str]]:
         "induction": (InductionMotor, {"synchronous_rpm", "rated_rpm"},
                       {"rated_moment", "rated_power", "overload", "ratio", "efficiency"}),
     }
-    if kind not in fields:
+    if not isinstance(kind, str) or kind not in fields:
         return None, [f"motor: kind must be one of {sorted(fields)}, got {kind!r}"]
     cls, required, optional = fields[kind]
+    where = f"motor ({kind})"
+    problems: list[str] = []
+    if unknown_keys({k: v for k, v in spec.items() if k != "kind"}, required | optional, where, problems):
+        return None, problems
     given = set(spec) - {"kind"}
-    problems = []
-    if given - required - optional:
-        problems.append(f"motor ({kind}): unknown keys {sorted(given - required - optional)} "
-                        f"(known: {sorted(required | optional)})")
     if required - given:
-        problems.append(f"motor ({kind}): missing {sorted(required - given)}")
-    for k in given & (required | optional):
+        problems.append(f"{where}: missing {sorted(required - given)}")
+    ranges = {"moment": ("real", "N m"), "stall_moment": ("real", "N m"), "no_load_speed": ("positive", "rad/s"),
+              "ratio": ("positive", ""), "synchronous_rpm": ("positive", "rpm"), "rated_rpm": ("positive", "rpm"),
+              "rated_power": ("positive", "W"), "rated_moment": ("positive", "N m")}
+    args = {}
+    for k in sorted(given):
         v = spec[k]
-        if not (isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)):
-            problems.append(f"motor ({kind}): {k} must be a number, got {v!r}")
-        elif k in ("no_load_speed", "ratio", "synchronous_rpm", "rated_rpm", "rated_power",
-                   "rated_moment") and v <= 0:
-            problems.append(f"motor ({kind}): {k} must be > 0, got {v!r}")
-        elif k == "efficiency" and not 0 < v <= 1:
-            problems.append(f"motor ({kind}): efficiency must be in (0, 1], got {v!r}")
-        elif k == "overload" and v <= 1:
-            problems.append(f"motor ({kind}): overload (M_k / M_nom) must be > 1, got {v!r}")
+        if k == "efficiency":
+            if _is_real(v) and 0 < v <= 1:
+                args[k] = float(v)
+            else:
+                problems.append(f"{where}: efficiency must be a number in (0, 1], got {v!r}")
+        elif k == "overload":
+            if _is_real(v) and 1 < v <= 1e50:
+                args[k] = float(v)
+            else:
+                problems.append(f"{where}: overload (M_k / M_nom) must be a number in (1, 1e+50], got {v!r}")
+        else:
+            args[k] = check_number(v, where, k, problems, *ranges[k])
     if problems:
         return None, problems
-    args = {k: float(spec[k]) for k in given}
     if kind == "induction":
         if ("rated_moment" in args) == ("rated_power" in args):
-            return None, ["motor (induction): give exactly one of rated_moment (N m) or rated_power (W)"]
+            return None, [f"{where}: give exactly one of rated_moment (N m) or rated_power (W)"]
         if args["rated_rpm"] >= args["synchronous_rpm"]:
-            return None, [f"motor (induction): rated_rpm {args['rated_rpm']} must be below "
+            return None, [f"{where}: rated_rpm {args['rated_rpm']} must be below "
                           f"synchronous_rpm {args['synchronous_rpm']}"]
         if "rated_power" in args:
             args["rated_moment"] = args.pop("rated_power") / (args["rated_rpm"] * RPM)
     return cls(**args), []
+
+
+def _is_real(v: Any) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)

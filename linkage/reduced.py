@@ -114,9 +114,23 @@ def reduced_characteristics(
         kg m^2.
     ends : array_like of bool, optional
         Positions that end the cycle (two-valued loads at stroke ends, METHOD section 7).
+
+    Raises
+    ------
+    DynamicsInputError
+        ``rotation`` not +1 / -1, or ``extra_inertia`` not a finite number >= 0 (a ``ValueError``
+        too).
     """
-    if rotation not in (1, -1):
-        raise ValueError(f"rotation must be +1 or -1, got {rotation!r}")
+    problem = None
+    if isinstance(rotation, bool) or rotation not in (1, -1):
+        problem = f"rotation must be +1 or -1, got {rotation!r}"
+    elif not (isinstance(extra_inertia, (int, float, np.integer, np.floating)) and np.isfinite(extra_inertia)
+              and extra_inertia >= 0):
+        problem = f"extra_inertia must be a finite number >= 0 (kg m^2), got {extra_inertia!r}"
+    if problem:
+        from .dynamics import DynamicsInputError  # late: dynamics imports this module
+
+        raise DynamicsInputError(problem)
     motion = analyze(mech, phi, order=2, omega=float(rotation), eps=0.0)
     loads = loads_of(mech) if loads is None else loads
     n = len(motion.phi)

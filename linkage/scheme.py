@@ -18,7 +18,7 @@ import tomllib
 from pathlib import Path
 from typing import Any, Callable, Mapping
 
-from .errors import SchemeError, StructureError
+from .errors import LinkageError, SchemeError
 from .model import Mechanism, MechanismBuilder, Prismatic, Revolute, _angle, _is_number, unknown_keys
 
 __all__ = ["load", "loads", "dumps", "save", "shipped_schemes", "scheme_path", "section_of",
@@ -187,9 +187,10 @@ def from_dict(data: Mapping[str, Any], default_name: str = "mechanism") -> Mecha
 
     problems: list[str] = []
     extra_sections = {k: v for k, v in data.items() if k in SECTION_PARSERS}
-    unknown_keys(data, TOP_KEYS | set(SECTION_PARSERS), "top-level", problems)
     name = data.get("name", default_name)
     builder = MechanismBuilder(str(name), str(data.get("description", "")), str(data.get("frame", "0")))
+    if unknown_keys(data, TOP_KEYS | set(SECTION_PARSERS), "top-level", problems) & {"input", "inputs"}:
+        builder.reject(inputs=True)
     links = _table(data, "links", problems)
     for lname, spec in links.items():
         if not isinstance(spec, Mapping):
@@ -234,7 +235,9 @@ def from_dict(data: Mapping[str, Any], default_name: str = "mechanism") -> Mecha
     try:
         structure_of(mech)
         assembly_branches(mech)
-    except StructureError as exc:
+    except SchemeError:
+        raise
+    except LinkageError as exc:  # a wrong mobility, a group that never assembles ...
         raise SchemeError(str(exc)) from None
     for section in _section_order():
         if section not in mech.parts:
@@ -274,7 +277,7 @@ def _add_pair(builder, name, spec, problems, link_names=None) -> bool:
     if not isinstance(spec, Mapping):
         problems.append(f"{where}: expected a table, got {spec!r}")
         return False
-    if unknown_keys(spec, PAIR_KEYS, where, problems):
+    if unknown_keys(spec, PAIR_KEYS, where, problems) or (set(spec) - PAIR_KEYS and "links" not in spec):
         return False  # a misspelt key: the pair is incomplete, say so once
     raw_kind = spec.get("kind", "R")
     kind = PAIR_KINDS.get(raw_kind) if isinstance(raw_kind, str) else None

@@ -16,6 +16,8 @@ import numpy as np
 
 from assur.base import global_point
 
+from ..errors import InputError
+
 __all__ = ["draw_mechanism", "plot_columns"]
 
 
@@ -101,7 +103,7 @@ def plot_columns(columns: dict, names: Sequence[str], ax=None):
     phi = columns["phi_deg"]
     for name in names:
         if name not in columns:
-            raise ValueError(f"no column {name!r}; columns: {list(columns)}")
+            raise InputError(f"no column {name!r}; columns: {list(columns)}")
         ax.plot(phi, columns[name], label=name)
     ax.set_xlabel("phi, deg")
     ax.legend()

@@ -30,6 +30,8 @@ from typing import Any, Mapping
 
 import numpy as np
 
+from ..errors import InputError
+
 __all__ = ["FORMATS", "format_columns"]
 
 #: the output formats understood by :func:`format_columns`
@@ -63,7 +65,7 @@ def format_columns(columns: Mapping[str, Any], fmt: str = "table",
         The text, ending with a newline (except ``json``, one line without a newline).
     """
     if fmt not in FORMATS:
-        raise ValueError(f"unknown table format {fmt!r}: expected one of {', '.join(FORMATS)}")
+        raise InputError(f"unknown table format {fmt!r}: expected one of {', '.join(FORMATS)}")
     cols = _check(columns)
     if fmt == "csv":
         return _csv(cols)
@@ -74,14 +76,14 @@ def format_columns(columns: Mapping[str, Any], fmt: str = "table",
 
 def _check(columns: Mapping[str, Any]) -> dict[str, np.ndarray]:
     if not columns:
-        raise ValueError("a table needs at least one column")
+        raise InputError("a table needs at least one column")
     cols = {str(k): np.asarray(v) for k, v in columns.items()}
     bad = [k for k, v in cols.items() if v.ndim != 1]
     if bad:
-        raise ValueError(f"table columns must be 1-D arrays: {bad} are not")
+        raise InputError(f"table columns must be 1-D arrays: {bad} are not")
     lengths = {k: len(v) for k, v in cols.items()}
     if len(set(lengths.values())) > 1:
-        raise ValueError(f"table columns must have equal lengths, got {lengths}")
+        raise InputError(f"table columns must have equal lengths, got {lengths}")
     return cols
 
 
