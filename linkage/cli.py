@@ -259,8 +259,12 @@ def _report_failures(motion) -> list[dict]:
             shown = ", ".join(f"{phi_deg[i]:.6g}" for i in where)
             _note("warning", f"mechanism '{motion.mechanism.name}' {what} at phi (deg) = {shown}: "
                              f"{blank} in those rows")
-            failed += [{"position": int(i) + 1, "phi_deg": float(phi_deg[i]), "problem": what}
-                       for i in where]
+            for i in where:
+                entry = {"position": int(i) + 1, "phi_deg": float(phi_deg[i]), "problem": what}
+                if code == SINGULAR:  # the least conditioned group: its distance to the singularity
+                    worst = min(motion.conditioning.items(), key=lambda kv: np.nan_to_num(kv[1][i], nan=2.0))
+                    entry.update(group=worst[0], conditioning=float(worst[1][i]))
+                failed.append(entry)
     failed.sort(key=lambda f: f["position"])
     return failed
 
@@ -379,9 +383,9 @@ def _cmd_dynamics(args: argparse.Namespace) -> int:
     if args.format == "json":
         _out(format_columns(report.columns(), "json", meta=summary))
     else:
-        shown = {k: (f"{v:.6g}" if isinstance(v, float) else ("none needed" if v is None and
-                 k == "flywheel_inertia" else v)) for k, v in summary.items() if v is not None
-                 or k == "flywheel_inertia"}
+        in_words = {"flywheel_inertia": "none needed", "dynamic_coefficient": "undefined (see the note)"}
+        shown = {k: (f"{v:.6g}" if isinstance(v, float) else in_words[k] if v is None else v)
+                 for k, v in summary.items() if v is not None or k in in_words}
         _out(format_columns(report.columns(), "table", meta=shown))
     return 0
 

@@ -31,7 +31,7 @@ from scipy.integrate import solve_ivp
 from scipy.interpolate import CubicSpline
 from scipy.optimize import brentq
 
-from .errors import LinkageError, SchemeError
+from .errors import DynamicsError, DynamicsInputError, LinkageError, SchemeError
 from .extremes import extreme_positions, table_angles
 from .kinematics import analyze
 from .kinetostatics import solve_reactions
@@ -54,18 +54,6 @@ __all__ = [
     "run_dynamics",
     "DynamicsReport",
 ]
-
-
-class DynamicsError(LinkageError):
-    """The machine stalls, runs away, the steady state cannot be found, or the problem's numbers
-    leave float64's range (the message says which quantity and why)."""
-
-
-class DynamicsInputError(DynamicsError, ValueError):
-    """An argument of a dynamics function is out of range; the message names it and its value.
-
-    Also a ``ValueError``, so code that catches ``ValueError`` for bad arguments keeps working.
-    """
 
 
 #: The exact energy method resolves ``delta`` from speeds computed in float64: each carries a
@@ -449,7 +437,8 @@ def _override(mech, spec, delta, mean_speed, positions=None) -> DynamicsSpec:
             spec = dynamics_of(mech)
     changes: dict[str, Any] = {}
     if delta is not None:
-        _require(_real(delta), "delta", delta, "a finite number > 0 (the coefficient of speed fluctuation)")
+        _require(_real(delta) and delta < 2, "delta", delta,
+                 "a number in (0, 2) (the coefficient of speed fluctuation (w_max - w_min) / w_m)")
         changes["delta"] = float(delta)
     if mean_speed is not None:
         _require(_real(mean_speed), "mean_speed", mean_speed, "a finite nonzero number (rad/s; its sign is the "

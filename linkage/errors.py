@@ -6,7 +6,9 @@
 - :class:`StructureError` -- the mechanism's structure is wrong (mobility, not decomposable);
 - :class:`AssemblyError` -- a group cannot be assembled at some input angles;
 - :class:`InputError` -- a function of the library was called with a bad argument (an order, a
-  direction, a motion without the analogs a computation needs).
+  direction, a motion without the analogs a computation needs);
+- :class:`DynamicsError` -- the machine stalls, runs away, has no steady state, or its numbers
+  leave float64's range; :class:`DynamicsInputError` is a bad argument of a dynamics function.
 
 :class:`SchemeError` and :class:`InputError` are also ``ValueError`` s, so code that catches
 ``ValueError`` keeps working.
@@ -14,7 +16,8 @@
 
 from __future__ import annotations
 
-__all__ = ["LinkageError", "SchemeError", "StructureError", "AssemblyError", "InputError"]
+__all__ = ["LinkageError", "SchemeError", "StructureError", "AssemblyError", "InputError",
+           "DynamicsError", "DynamicsInputError"]
 
 
 class LinkageError(Exception):
@@ -56,3 +59,12 @@ class AssemblyError(LinkageError):
 class InputError(LinkageError, ValueError):
     """A function was called with a bad argument (a value out of its range, a motion without the
     analogs or speeds the computation needs, an unknown name)."""
+
+
+class DynamicsError(LinkageError):
+    """The machine stalls, runs away, the steady state cannot be found, or the problem's numbers
+    leave float64's range (the message says which quantity and why)."""
+
+
+class DynamicsInputError(DynamicsError, InputError):
+    """An argument of a dynamics function is out of range; the message names it and its value."""

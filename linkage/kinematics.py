@@ -24,7 +24,7 @@ from numpy.typing import ArrayLike
 from assur.base import ANALOG_TOL, CANNOT_ASSEMBLE, OK, SINGULAR, global_point, perp, point_analogs, rotate
 
 from .assembly import assembly_branches, assembly_plans, place_group
-from .errors import AssemblyError, StructureError
+from .errors import AssemblyError, InputError, StructureError
 from .model import Mechanism, Prismatic
 from .structure import Structure, decompose
 
@@ -112,13 +112,13 @@ class Motion:
     def _point(self, name: str):
         link = self.mechanism.point_link(name)
         if link not in self.poses:
-            raise ValueError(f"point '{name}' (link '{link}') was not among the requested outputs")
+            raise InputError(f"point '{name}' (link '{link}') was not among the requested outputs")
         return link, self.mechanism.links[link].points[name]
 
     def _need(self, order: int) -> None:
         have = 0 if self.first is None else 1 if self.second is None else 2
         if have < order:
-            raise ValueError(f"analogs of order {order} were not computed (analyze(..., order={order}))")
+            raise InputError(f"analogs of order {order} were not computed (analyze(..., order={order}))")
 
     def quantity(self, name: str) -> tuple[np.ndarray, np.ndarray | None, np.ndarray | None]:
         """Value and first / second analogs of ``"P.x"``, ``"P.y"``, ``"L.theta"`` or ``"K.s"``."""
@@ -159,7 +159,7 @@ class Motion:
 
     def _need_speed(self) -> None:
         if self.omega is None:
-            raise ValueError("real velocities need omega (analyze(..., omega=..., eps=...))")
+            raise InputError("real velocities need omega (analyze(..., omega=..., eps=...))")
 
     # -- table ---------------------------------------------------------------------------------
     def columns(self) -> dict[str, np.ndarray]:
@@ -194,7 +194,7 @@ def parse_quantity(mech: Mechanism, name: str) -> tuple[str, str, int]:
         return "link", obj, 2
     if coord == "s" and isinstance(mech.pairs.get(obj), Prismatic):
         return "slide", obj, 0
-    raise ValueError(
+    raise InputError(
         f"unknown quantity {name!r} of mechanism '{mech.name}': expected 'P.x' / 'P.y' for a point "
         f"{mech.point_names}, 'L.theta' for a moving link {mech.moving_links}, or 'K.s' for a "
         f"prismatic pair {sorted(k for k, p in mech.pairs.items() if isinstance(p, Prismatic))}"
@@ -241,9 +241,9 @@ def analyze(
     Motion
     """
     if order not in (0, 1, 2):
-        raise ValueError(f"order must be 0, 1 or 2, got {order!r}")
+        raise InputError(f"order must be 0, 1 or 2, got {order!r}")
     if on_failure not in ("raise", "mask"):
-        raise ValueError(f"on_failure must be 'raise' or 'mask', got {on_failure!r}")
+        raise InputError(f"on_failure must be 'raise' or 'mask', got {on_failure!r}")
     structure = structure_of(mech)
     if len(structure.inputs) != 1:
         raise StructureError(
@@ -251,7 +251,7 @@ def analyze(
             "angle needs exactly one input link")
     phi = np.atleast_1d(np.asarray(phi, dtype=float))
     if phi.ndim != 1 or not np.all(np.isfinite(phi)):
-        raise ValueError("phi must be a finite scalar or 1-D array of angles in rad")
+        raise InputError("phi must be a finite scalar or 1-D array of angles in rad")
     plans = assembly_plans(mech)
     group_ids = range(len(structure.groups)) if outputs is None else \
         structure.needed_groups(_links_of(mech, outputs))

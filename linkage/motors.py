@@ -19,6 +19,8 @@ from typing import Any, Mapping
 
 import numpy as np
 
+from .errors import DynamicsInputError
+
 __all__ = ["ConstantMotor", "LinearMotor", "InductionMotor", "motor_from_spec", "RPM"]
 
 RPM = 2 * math.pi / 60  # rad/s per rpm
@@ -122,7 +124,6 @@ class InductionMotor:
 
 
 def _fail(message: str) -> None:
-    from .dynamics import DynamicsInputError  # late: dynamics imports this module
 
     raise DynamicsInputError(message)
 

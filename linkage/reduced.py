@@ -27,6 +27,7 @@ from numpy.typing import ArrayLike
 
 from assur.base import point_analogs
 
+from .errors import DynamicsInputError
 from .forces import Loads, evaluate_loads, loads_of
 from .kinematics import analyze
 from .model import Mechanism
@@ -128,7 +129,6 @@ def reduced_characteristics(
               and extra_inertia >= 0):
         problem = f"extra_inertia must be a finite number >= 0 (kg m^2), got {extra_inertia!r}"
     if problem:
-        from .dynamics import DynamicsInputError  # late: dynamics imports this module
 
         raise DynamicsInputError(problem)
     motion = analyze(mech, phi, order=2, omega=float(rotation), eps=0.0)

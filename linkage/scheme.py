@@ -19,7 +19,8 @@ from pathlib import Path
 from typing import Any, Callable, Mapping
 
 from .errors import LinkageError, SchemeError
-from .model import Mechanism, MechanismBuilder, Prismatic, Revolute, _angle, _is_number, unknown_keys
+from .model import (MAX_ANGLE_DEG, Mechanism, MechanismBuilder, Prismatic, Revolute, _angle, _is_number,
+                    unknown_keys)
 
 __all__ = ["load", "loads", "dumps", "save", "shipped_schemes", "scheme_path", "section_of",
            "register_section", "SECTION_PARSERS"]
@@ -312,26 +313,34 @@ def _add_assembly(builder, point, spec, problems):
         problems.append(f"{where}: expected a table such as {{left_of = [\"A\", \"C\"]}}, got {spec!r}")
         return
     known = {"left_of", "right_of", "towards", "towards_deg", "from", "branch", "mode", "phi", "phi_deg"}
-    bad = set(spec) - known
-    if bad:
-        problems.append(f"{where}: unknown keys {sorted(bad)} (known: {sorted(known)})")
-    towards = spec.get("towards")
-    if "towards_deg" in spec:
-        towards = math.radians(spec["towards_deg"]) if _is_number(spec["towards_deg"]) else spec["towards_deg"]
+    if unknown_keys(spec, known, where, problems):
+        return  # one message: the misspelt key, not the condition it leaves incomplete
+    towards = _angle_key(spec, "towards", where, problems)
+    phi = _angle_key(spec, "phi", where, problems)
+    if towards is _BAD or phi is _BAD:
+        return
     builder.assembly(point, left_of=spec.get("left_of"), right_of=spec.get("right_of"),
                      towards=towards, origin=spec.get("from"), branch=spec.get("branch"),
-                     mode=spec.get("mode", "keep"), phi=_angle_key(spec, "phi", where, problems))
+                     mode=spec.get("mode", "keep"), phi=phi)
+
+
+_BAD = object()
 
 
 def _angle_key(spec, key, where, problems):
-    """The angle given as ``key`` (rad) or ``key_deg`` (deg), in rad; None when absent."""
-    if f"{key}_deg" in spec:
-        raw = spec[f"{key}_deg"]
-        if _is_number(raw):
-            return math.radians(raw)
-        problems.append(f"{where}: {key}_deg must be a number, got {raw!r}")
+    """The angle given as ``key`` (rad) or ``key_deg`` (deg), in rad; None when absent, ``_BAD``
+    (with the problem reported) when it is not a number within +-MAX_ANGLE_DEG."""
+    name = f"{key}_deg" if f"{key}_deg" in spec else key
+    if name not in spec:
         return None
-    return spec.get(key)
+    raw = spec[name]
+    degrees = raw if name.endswith("_deg") else (math.degrees(raw) if _is_number(raw) else raw)
+    if not (_is_number(raw) and math.isfinite(degrees) and abs(degrees) <= MAX_ANGLE_DEG):
+        unit = "deg" if name.endswith("_deg") else "rad"
+        problems.append(f"{where}: {name} must be a number of {unit} with |x| <= "
+                        f"{MAX_ANGLE_DEG:g} deg, got {raw!r}")
+        return _BAD
+    return math.radians(raw) if name.endswith("_deg") else float(raw)
 
 
 # ----------------------------------------------------------------------------------------------

@@ -245,3 +245,14 @@ def test_a_jump_the_change_point_search_missed_is_still_reported():
     # and a smooth motion sampled just as finely, or coarsely, raises nothing
     _, caught = _analyze(linkage.load("four_bar"), np.radians(np.arange(0.0, 360.0, 10.0)))
     assert caught == []
+
+
+@pytest.mark.parametrize("entry, message", [
+    ('left_of = ["A", "C"]\nfrom_ = "O"', "assembly.B: unknown keys \\['from_'\\]"),
+    ('left_of = ["A", "C"]\nphi_deg = 1e300', "assembly.B: phi_deg must be a number of deg with \\|x\\| <= 1e\\+06 deg, got 1e\\+300"),
+    ('from = "O"\ntowards_deg = "up"', "assembly.B: towards_deg must be a number of deg"),
+])
+def test_bad_assembly_entries_give_one_message_naming_the_entry(entry, message):
+    with pytest.raises(linkage.SchemeError, match=message) as info:
+        linkage.loads(four_bar(1, 2, 1, 2, entry).replace('mode = "keep"\n', ""), source="bad.toml")
+    assert len(info.value.problems) == 1 and info.value.problems[0].startswith("bad.toml: ")

@@ -396,8 +396,8 @@ def test_dynamics_course_slider_crank_against_mertsalov(capsys):
 
 
 def test_dynamics_no_flywheel_needed_with_a_large_delta(capsys):
-    doc, cols, _ = json_doc(capsys, "dynamics", "course_slider_crank", "--delta", "5")
-    ref = mertsalov(cols["reduced_moment_resistance"], 5.0)
+    doc, cols, _ = json_doc(capsys, "dynamics", "course_slider_crank", "--delta", "1.9")
+    ref = mertsalov(cols["reduced_moment_resistance"], 1.9)
     assert ref["required"] < I_0
     assert doc["flywheel_inertia"] is None
     assert doc["required_constant_inertia"] == pytest.approx(ref["required"], rel=1e-9)
@@ -409,7 +409,7 @@ def test_dynamics_no_flywheel_needed_with_a_large_delta(capsys):
     assert doc["dynamic_coefficient"] == pytest.approx(
         np.abs(cols["balancing_moment"]).max() / abs(doc["driving_moment"]), rel=1e-12)
     # the table says so in words
-    code, out, err = run(capsys, "dynamics", "course_slider_crank", "--delta", "5")
+    code, out, err = run(capsys, "dynamics", "course_slider_crank", "--delta", "1.9")
     assert code == 0, err
     assert "# flywheel_inertia: none needed" in out.splitlines()
 
@@ -530,3 +530,8 @@ def test_dynamics_ode_method_on_flying_shears(capsys):
 def test_dynamics_bad_method_exits_2(capsys):
     code, out, err = run(capsys, "dynamics", "course_slider_crank", "--method", "magic")
     assert code == 2 and out == ""
+
+
+def test_dynamics_refuses_a_delta_of_two_or_more(capsys):
+    code, out, err = run(capsys, "dynamics", "course_slider_crank", "--delta", "5")
+    assert code == 2 and "delta" in err and "(0, 2)" in err and "Traceback" not in err

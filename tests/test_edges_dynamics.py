@@ -113,6 +113,10 @@ def test_cli_prints_null_and_the_note(capsys):
     assert code == 0, err
     assert json.loads(out)["dynamic_coefficient"] is None
     assert "coefficient of dynamics undefined" in err
+    code = main(["dynamics", "four_bar", "--omega", "10", "--delta", "0.05", "--positions", "8"])
+    out, err = capsys.readouterr()
+    assert code == 0, err
+    assert "# dynamic_coefficient: undefined (see the note)" in out.splitlines()
 
 
 # ----------------------------------------------------------------------------------------------

@@ -154,3 +154,21 @@ guide = "low"''', '''[pairs.low]
 kind = "P"
 links = ["3", "5"]
 guide = "small"''')
+
+
+def test_cli_json_names_the_group_and_its_conditioning_at_a_singular_position(capsys, tmp_path):
+    import json
+
+    from linkage.cli import main
+
+    scheme = tmp_path / "toggle.toml"
+    scheme.write_text(CASES["RRR"].toml, encoding="utf-8")
+    start = float(np.degrees(CASES["RRR"].singular_phi - 1e-9))
+    code = main(["analyze", str(scheme), "--positions", "4", "--start", repr(start), "--format", "json"])
+    out, err = capsys.readouterr()
+    assert code == 0 and "singular" in err and "Traceback" not in err
+    failed = json.loads(out)["failed"]
+    singular = [f for f in failed if f["problem"] == "is singular"]
+    assert [f["position"] for f in singular] == [1, 5]
+    for f in singular:
+        assert f["group"] == "II-RRR(2,3)" and 0 < f["conditioning"] < 1e-4
