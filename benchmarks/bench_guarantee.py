@@ -25,17 +25,9 @@ sys.path.insert(0, str(ROOT / "tests"))
 
 import assur.base  # noqa: E402
 import linkage  # noqa: E402
-from _edge_mechanisms import CASES, CHAIN, reference  # noqa: E402
+from _edge_mechanisms import CASES, CHAIN, reference, relative_errors  # noqa: E402
 
 EPS = np.finfo(float).eps
-
-
-def _errors(motion, ref):
-    scale1 = max(max(abs(v[1]) for v in ref.values()), 1.0)
-    scale2 = max(max(abs(v[2]) for v in ref.values()), scale1)
-    e1 = max(abs(motion.quantity(q)[1][0] - v[1]) for q, v in ref.items()) / scale1
-    e2 = max(abs(motion.quantity(q)[2][0] - v[2]) for q, v in ref.items()) / scale2
-    return e1, e2
 
 
 def sweep(case, lines, factors):
@@ -56,7 +48,7 @@ def sweep(case, lines, factors):
             lines.append(f"| 1e-{k:02d} | — | — | — | — | {status} |")
             continue
         r = min(float(v[0]) for v in motion.conditioning.values())
-        e1, e2 = _errors(motion, reference(case, phi))
+        e1, e2 = relative_errors(motion, reference(case, phi))
         factor = e1 * r**2 / EPS
         factors.append(factor)
         lines.append(f"| 1e-{k:02d} | {r:.2e} | {e1:.1e} | {e2:.1e} | {factor:.2f} | {status} |")

@@ -39,6 +39,16 @@ def _derivatives(f: Callable[[mp.mpf], dict], phi: float) -> dict[str, tuple[flo
     return out
 
 
+def relative_errors(motion, ref) -> tuple[float, float]:
+    """Largest errors of a single-position motion's first and second analogs against ``ref``,
+    relative to the largest first analog (at least 1) and the largest second analog."""
+    scale1 = max(max(abs(v[1]) for v in ref.values()), 1.0)
+    scale2 = max(max(abs(v[2]) for v in ref.values()), scale1)
+    e1 = max(abs(motion.quantity(q)[1][0] - v[1]) for q, v in ref.items()) / scale1
+    e2 = max(abs(motion.quantity(q)[2][0] - v[2]) for q, v in ref.items()) / scale2
+    return e1, e2
+
+
 def reference(case: EdgeCase, phi: float) -> dict[str, tuple[float, float, float]]:
     """``quantity -> (value, q', q'')`` at ``phi`` from the mpmath closed form."""
     return _derivatives(case.reference, phi)

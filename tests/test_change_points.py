@@ -181,11 +181,7 @@ def test_isosceles_slider_crank_kept_rests_at_the_pivot_half_the_turn_with_a_war
     np.testing.assert_allclose(motion.point("B")[~right, 0], 0.0, atol=1e-9)
 
 
-def test_mode_and_angle_round_trip_through_scheme_files_and_the_builder():
-    mech = linkage.loads(four_bar(1, 2, 1, 2, PARALLELOGRAM, "follow"))
-    rule = mech.assembly[0]
-    assert (rule.mode, rule.phi) == ("follow", pytest.approx(np.pi / 2))
-    assert linkage.loads(linkage.dumps(mech)) == mech
+def _parallelogram_builder():
     b = linkage.MechanismBuilder("p")
     b.link("0", points={"O": (0.0, 0.0), "C": (2.0, 0.0)})
     b.link("1", line=("O", "A"), length=1.0)
@@ -193,6 +189,15 @@ def test_mode_and_angle_round_trip_through_scheme_files_and_the_builder():
     b.link("3", line=("C", "B"), length=1.0)
     for name, x, y in [("O", "0", "1"), ("A", "1", "2"), ("B", "2", "3"), ("C", "3", "0")]:
         b.revolute(name, x, y)
+    return b
+
+
+def test_mode_and_angle_round_trip_through_scheme_files_and_the_builder():
+    mech = linkage.loads(four_bar(1, 2, 1, 2, PARALLELOGRAM, "follow"))
+    rule = mech.assembly[0]
+    assert (rule.mode, rule.phi) == ("follow", pytest.approx(np.pi / 2))
+    assert linkage.loads(linkage.dumps(mech)) == mech
+    b = _parallelogram_builder()
     b.inputs("1").assembly("B", left_of=("A", "C"), phi=np.pi / 2, mode="follow")
     built = b.build()
     assert assembly_plans(built)[0].mode == "follow"
@@ -206,13 +211,7 @@ def test_mode_and_angle_round_trip_through_scheme_files_and_the_builder():
     ("keep", float("nan"), "input angle of the condition must be a finite number"),
 ])
 def test_bad_mode_or_angle_is_refused(mode, phi, message):
-    b = linkage.MechanismBuilder("p")
-    b.link("0", points={"O": (0.0, 0.0), "C": (2.0, 0.0)})
-    b.link("1", line=("O", "A"), length=1.0)
-    b.link("2", line=("A", "B"), length=2.0)
-    b.link("3", line=("C", "B"), length=1.0)
-    for name, x, y in [("O", "0", "1"), ("A", "1", "2"), ("B", "2", "3"), ("C", "3", "0")]:
-        b.revolute(name, x, y)
+    b = _parallelogram_builder()
     b.inputs("1").assembly("B", left_of=("A", "C"), phi=phi, mode=mode)
     with pytest.raises(linkage.SchemeError, match=message):
         b.build()

@@ -17,18 +17,9 @@ import linkage
 from assur import ANALOG_TOL
 from linkage.scheme import from_dict, to_dict
 
-from _edge_mechanisms import CASES, CHAIN, reference, rpp_reference, rpp_toml, _derivatives
+from _edge_mechanisms import CASES, CHAIN, reference, relative_errors, rpp_reference, rpp_toml, _derivatives
 
 DISTANCES = [10.0**-k for k in range(1, 17)]
-
-
-def _errors(motion, ref):
-    """Largest relative errors of the first and second analogs against the reference."""
-    scale1 = max(max(abs(v[1]) for v in ref.values()), 1.0)
-    scale2 = max(max(abs(v[2]) for v in ref.values()), scale1)
-    e1 = max(abs(motion.quantity(q)[1][0] - v[1]) for q, v in ref.items()) / scale1
-    e2 = max(abs(motion.quantity(q)[2][0] - v[2]) for q, v in ref.items()) / scale2
-    return e1, e2
 
 
 @pytest.mark.parametrize("case", [*CASES.values(), CHAIN], ids=lambda c: c.kind)
@@ -43,7 +34,7 @@ def test_ok_positions_keep_the_guarantee_toward_the_singularity(case):
             assert motion.status[0] in (-1, -2)
             assert np.isnan(motion.quantity(next(iter(reference(case, phi))))[1][0])
             continue
-        e1, e2 = _errors(motion, reference(case, phi))
+        e1, e2 = relative_errors(motion, reference(case, phi))
         assert e1 <= ANALOG_TOL, (case.kind, delta, e1)
         assert e2 <= 10 * ANALOG_TOL, (case.kind, delta, e2)
         # the reported bound really bounds the error
@@ -74,7 +65,7 @@ def test_scotch_yoke_with_the_slot_turned_toward_the_rail(gamma_deg):
     motion = linkage.analyze(mech, [0.7], on_failure="mask")
     gamma = np.radians(gamma_deg)
     if motion.status[0] == 0:
-        e1, e2 = _errors(motion, _derivatives(rpp_reference(gamma_deg), 0.7))
+        e1, e2 = relative_errors(motion, _derivatives(rpp_reference(gamma_deg), 0.7))
         assert e1 <= ANALOG_TOL and e2 <= 10 * ANALOG_TOL
     else:
         assert motion.status[0] == -2
