@@ -121,6 +121,8 @@ def scheme_path(name_or_path: str | Path) -> Path:
     """The file of a shipped scheme name, or the given path."""
     path = Path(name_or_path)
     if path.suffix == ".toml" or path.exists():
+        if path.is_dir():
+            raise SchemeError(f"{path}: is a folder, not a scheme file (give the path of a .toml file)")
         if not path.is_file():
             raise SchemeError(f"{path}: no such scheme file")
         return path
@@ -140,7 +142,14 @@ def load(name_or_path: str | Path) -> Mechanism:
         Listing every problem, each prefixed with the file name.
     """
     path = scheme_path(name_or_path)
-    return loads(path.read_text(encoding="utf-8"), source=str(path), default_name=path.stem)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except UnicodeDecodeError as exc:
+        raise SchemeError(f"{path}: not a text file in UTF-8 (byte {exc.start} cannot be read); a "
+                          "scheme file is TOML text") from None
+    except OSError as exc:
+        raise SchemeError(f"{path}: cannot be read ({exc.strerror})") from None
+    return loads(text, source=str(path), default_name=path.stem)
 
 
 def loads(text: str, source: str = "<string>", default_name: str = "mechanism") -> Mechanism:

@@ -449,3 +449,12 @@ def test_cli_never_prints_a_numpy_warning_or_a_traceback(capsys, monkeypatch):
     assert code == 1 and out == "" and "Traceback" not in err
     assert err.strip() == ("linkage: error: internal error (ZeroDivisionError: division by zero); please "
                            "report it with the command line that caused it")
+
+
+def test_a_folder_or_a_binary_file_is_named_as_such(tmp_path):
+    with pytest.raises(SchemeError, match="is a folder, not a scheme file"):
+        linkage.load(tmp_path)
+    binary = tmp_path / "binary.toml"
+    binary.write_bytes(b"name = \"x\"\n\xd0\xff\x00")
+    with pytest.raises(SchemeError, match=r"binary\.toml: not a text file in UTF-8 \(byte 11"):
+        linkage.load(binary)
