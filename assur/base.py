@@ -1,4 +1,4 @@
-"""The group protocol and the constraint machinery every group kind shares (METHOD section 3).
+"""The group protocol and the constraint machinery every group kind shares (docs/methods.md#analogs).
 
 Shapes and conventions
 ----------------------
@@ -108,7 +108,7 @@ def global_point(pose: np.ndarray, local) -> np.ndarray:
 
 
 def point_analogs(pose, first, second, local):
-    """First and second analogs ``(N, 2)`` of a point fixed in a link (METHOD section 3)."""
+    """First and second analogs ``(N, 2)`` of a point fixed in a link (docs/methods.md#analogs)."""
     rho = rotate(pose[:, 2], local)
     d1 = None if first is None else first[:, :2] + perp(rho) * first[:, 2:3]
     d2 = None
@@ -151,7 +151,7 @@ class RevoluteJoint:
         return out
 
     def quadratic(self, poses: Poses, first: Poses) -> np.ndarray:
-        """Right-hand side terms of the second-analog system (gamma of METHOD section 3)."""
+        """Right-hand side terms of the second-analog system (gamma of docs/methods.md#analogs)."""
         ta, tb = first[self.a][:, 2:3], first[self.b][:, 2:3]
         return ta**2 * rotate(poses[self.a][:, 2], self.pa) - tb**2 * rotate(poses[self.b][:, 2], self.pb)
 
@@ -415,7 +415,7 @@ class Group(ABC):
     def analogs(self, poses: Poses, first: Poses, second: Poses | None = None, valid=None):
         """First (and, if ``second`` of the known links is given, second) analogs of the group.
 
-        Solves ``Phi_q q' = -Phi_k q'_k`` and ``Phi_q q'' = -Phi_k q''_k + gamma`` (METHOD 3).
+        Solves ``Phi_q q' = -Phi_k q'_k`` and ``Phi_q q'' = -Phi_k q''_k + gamma`` (docs/methods.md#analogs).
         Positions outside ``valid`` (default: where the group is assembled and not singular)
         give NaN.
         """

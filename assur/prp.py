@@ -1,6 +1,6 @@
 """PRP dyad: sliders L1 and L2 on guides of known links, pinned to each other at B.
 
-Closed form (METHOD section 4): both angles are fixed by the guides, so B is the intersection of
+Closed form (docs/methods.md#positions-the-five-dyads): both angles are fixed by the guides, so B is the intersection of
 two lines; parallel guides cannot be assembled. One branch only.
 """
 

@@ -1,7 +1,7 @@
 """RPP dyad: link L1 pinned to a known link at A slides in a guide of link L2; L2 slides on a
 guide of a known link (e.g. the Scotch yoke).
 
-Closed form (METHOD section 4): both angles follow from the guides, and L2's origin from one
+Closed form (docs/methods.md#positions-the-five-dyads): both angles follow from the guides, and L2's origin from one
 2x2 linear system (the two guide lines' normal equations). Parallel guides cannot be assembled.
 """
 

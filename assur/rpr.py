@@ -1,7 +1,7 @@
 """RPR dyad: block L1 pinned to a known link at A slides along a guide of link L2, which is
 pinned to a known link at C (the slotted link).
 
-Closed form (METHOD section 4): with ``d = |A - C|``, ``psi`` the direction of ``A - C`` and ``e``
+Closed form (docs/methods.md#positions-the-five-dyads): with ``d = |A - C|``, ``psi`` the direction of ``A - C`` and ``e``
 the signed distance of the slide axis from C, ``theta_2 = psi - alpha0 - asin(e/d)`` (M = +1,
 A ahead of C along the guide direction) or ``psi - alpha0 - pi + asin(e/d)`` (M = -1);
 ``d < |e|`` cannot be assembled.

@@ -1,7 +1,7 @@
 """RRP dyad: link L1 pinned to a known link at A and to slider L2 at B; L2 slides on a guide of
 a known link.
 
-Closed form (METHOD section 4): the slider's angle is fixed by the guide, so B runs on a line
+Closed form (docs/methods.md#positions-the-five-dyads): the slider's angle is fixed by the guide, so B runs on a line
 ``G_B + s u``; with ``h = n . (A - G_B)``: ``s = u . (A - G_B) + M sqrt(l^2 - h^2)``.
 Branch ``M = +1`` puts B ahead of A's foot along the guide direction ``u``.
 """

@@ -1,6 +1,6 @@
 """RRR dyad: two binary links pinned to known links at A and C and to each other at B.
 
-Closed form (METHOD section 4): ``d = |C - A|``, ``a = (l2^2 - l3^2 + d^2) / (2 d)``,
+Closed form (docs/methods.md#positions-the-five-dyads): ``d = |C - A|``, ``a = (l2^2 - l3^2 + d^2) / (2 d)``,
 ``h^2 = l2^2 - a^2`` (< 0: cannot be assembled), ``B = A + a e + M h E e``.
 Branch ``M = +1`` puts B to the left of the directed line A -> C (A on link L1, C on link L2).
 """

@@ -8,7 +8,6 @@ it, and (with matplotlib) draws omega(phi) and M_b(phi) into OUTPUT_DIR (default
 import sys
 from pathlib import Path
 
-import numpy as np
 
 import linkage
 from linkage.dynamics import run_dynamics
@@ -39,9 +38,11 @@ except ImportError:
     sys.exit(0)
 out = Path(sys.argv[1] if len(sys.argv) > 1 else "out")
 out.mkdir(parents=True, exist_ok=True)
-columns["psi_deg"] = np.abs(columns["phi_deg"] - columns["phi_deg"][0])
-for name in ("omega", "balancing_moment"):
-    ax = plot_columns({"phi_deg": columns["psi_deg"], name: columns[name]}, [name])
+labels = {"omega": "crank angular velocity ω, rad/s", "balancing_moment": "balancing moment M_b, N·m"}
+for name, label in labels.items():
+    ax = plot_columns(columns, [name])          # phi_deg runs from the start of the cycle
     ax.set_xlabel("crank angle from the start of the cycle, deg")
+    ax.set_ylabel(label)
+    ax.get_legend().remove()
     ax.figure.savefig(out / f"course_{name}.png", dpi=100)
 print(f"\nplots written to {out}/")

@@ -1,16 +1,22 @@
 """The ``linkage`` command line.
 
     linkage schemes                                   list the shipped schemes
-    linkage analyze SCHEME [--positions N] [--start extreme|max|min|DEG] [--format table|csv|json]
+    linkage analyze SCHEME [--positions N] [--start extreme|max|min|DEG] [--columns LIST]
+                           [--format table|csv|json]
     linkage forces SCHEME [--positions N] [--omega RAD_S | --rpm RPM] [--eps RAD_S2]
-                          [--start ...] [--format table|csv|json]
+                          [--start ...] [--columns LIST] [--format table|csv|json]
     linkage dynamics SCHEME [--positions N] [--delta D] [--rpm R | --omega W]
-                            [--method course|exact|ode] [--format table|json]
+                            [--method course|exact|ode] [--transient] [--columns LIST]
+                            [--format table|csv|json]
 
 Every subcommand is one ``_add_<name>(subparsers)`` function that registers its parser and sets
 ``handler`` to a function ``(args) -> int``; add a new command by writing such a pair and listing
 the registering function in :data:`COMMANDS`. Tables go to stdout through
-:func:`linkage.report.format_columns`; notes, warnings and errors go to stderr. Errors of the
+:func:`linkage.report.format_columns`: CSV and JSON carry every column, the table for people a
+default selection at most :data:`TABLE_WIDTH` characters wide (frame points left out), and
+``--columns`` chooses the columns in every format (:data:`CONVENTIONS` says what they mean).
+Defaults follow the scheme: positions, start, speed and loads declared in it. Notes, warnings
+and errors go to stderr, each note once per run. Errors of the
 input (:class:`linkage.LinkageError`, ``ValueError``) print one line per problem and exit with
 status 2, without a traceback; warnings are printed as ``linkage: warning: ...`` lines (never as
 Python's warning text); an unexpected exception (a bug) prints one ``internal error`` line and
@@ -20,8 +26,10 @@ exits with status 1.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import math
 import os
+import re
 import sys
 import warnings
 from typing import Callable, Sequence
@@ -31,10 +39,11 @@ import numpy as np
 from . import __version__
 from .errors import InputError, LinkageError, SchemeError
 from .extremes import table_angles
-from .kinematics import analyze, structure_of
+from .kinematics import analyze, structure_of, table_positions_deg
 from .motors import RPM
 from .model import MAX_ANGLE_DEG, MAX_MAGNITUDE, MAX_POSITIONS
 from .report import FORMATS, format_columns
+from .report.tables import select_columns, table_width, units_of
 from .scheme import load, section_of, shipped_schemes
 
 __all__ = ["main", "COMMANDS"]
@@ -45,6 +54,32 @@ PROG = "linkage"
 EXIT_INPUT = 2
 #: exit status of an unexpected exception (a bug of the library)
 EXIT_INTERNAL = 1
+
+#: widest default table for people, characters (``--columns`` may ask for more)
+TABLE_WIDTH = 160
+
+#: the conventions of every table (the epilog of ``--help``; docs/conventions.md has the rest)
+CONVENTIONS = """\
+table conventions (docs/conventions.md):
+  i            position number, 1 .. n+1; position n+1 is position 1 one turn later
+  phi_deg      input angle travelled from position 1 in the direction of rotation, deg:
+               0, 360/n, ... 360 whatever the sense of rotation (over an input range A..B:
+               from A towards B; in the start-up of --transient: 360 per cycle). Position 1
+               is the declared start: the output's extreme position, --start DEG or A; the
+               sense is the sign of the speed (--omega / --rpm, else the scheme's mean speed,
+               else counter-clockwise). The '# start:' line (JSON: phi0_deg, direction) says
+               both.
+  L.theta      absolute angle of link L, CCW from +x, rad, in (-pi, pi]; for the input link
+               it is the absolute input angle phi = phi0 + direction * phi_deg
+  K.angle_deg  direction of a force, deg CCW from +x, in (-180, 180]
+  q' q''       analogs dq/dphi, d2q/dphi2, per radian of the input angle (m/rad, rad/rad ...)
+  units        SI: m, rad, N, N m, kg m^2, s (deg where the name ends in _deg); the table
+               for people gives each column's unit in brackets under its name, JSON under
+               "units"
+  columns      the table for people shows the columns that matter within 160 characters and
+               leaves out the frame points; CSV and JSON carry every column. --columns
+               'B.*,3.theta' chooses columns by names and shell-style patterns (after i and
+               phi_deg) in every format; --columns '*' gives them all."""
 
 
 def _declared_dynamics(mech):
@@ -77,10 +112,39 @@ def _out(text: str) -> None:
     _write(sys.stdout, text if text.endswith("\n") else text + "\n")
 
 
+#: the notes and warnings already said in this run (each is said once per run)
+_SAID: set[str] = set()
+
+
 def _note(kind: str, message: str) -> None:
-    """One ``linkage: <kind>: ...`` line on stderr per line of ``message``."""
+    """One ``linkage: <kind>: ...`` line on stderr per line of ``message``; a note or warning
+    already said in this run is not said again (errors always are)."""
     for line in str(message).splitlines() or [""]:
-        _write(sys.stderr, f"{PROG}: {kind}: {line}\n")
+        text = f"{PROG}: {kind}: {_in_cli_terms(line)}\n"
+        if kind != "error":
+            if text in _SAID:
+                continue
+            _SAID.add(text)
+        _write(sys.stderr, text)
+
+
+#: advice of the Python API in messages of the library, and what it is on the command line
+_IN_CLI_TERMS = (
+    (re.compile(r" ?\(use on_failure='mask'[^)]*\)"),
+     " (`linkage analyze SCHEME` shows every position, with the rows of these ones empty)"),
+    (re.compile(r"; see Motion\.conditioning\)"), ")"),
+    (re.compile(r"or pass delta="), "or give --delta"),
+    (re.compile(r"pass mean_speed="), "give --omega or --rpm"),
+    (re.compile(r"use the course method"), "use --method course"),
+)
+
+
+def _in_cli_terms(line: str) -> str:
+    """A message of the library with its Python advice (``on_failure='mask'`` ...) said in the
+    command line's terms."""
+    for pattern, replacement in _IN_CLI_TERMS:
+        line = pattern.sub(replacement, line)
+    return line
 
 
 def _error_lines(exc: BaseException) -> list[str]:
@@ -92,6 +156,16 @@ def _error_lines(exc: BaseException) -> list[str]:
 # ----------------------------------------------------------------------------------------------
 # linkage schemes
 # ----------------------------------------------------------------------------------------------
+
+
+class _HelpFormatter(argparse.HelpFormatter):
+    """argparse's formatter, except that a text with line breaks of its own (the epilog of
+    conventions) is printed as written."""
+
+    def _fill_text(self, text, width, indent):
+        if "\n" in text:
+            return "".join(indent + line for line in text.splitlines(keepends=True))
+        return super()._fill_text(text, width, indent)
 
 
 def _add_schemes(sub) -> None:
@@ -164,35 +238,216 @@ def _add_scheme_argument(p: argparse.ArgumentParser) -> None:
                    help="a shipped scheme name (see 'linkage schemes') or the path of a .toml file")
 
 
+class InputRange:
+    """``--range A B``: the table runs over the input angles A..B (deg) instead of a turn."""
+
+    def __init__(self, a: float, b: float):
+        self.a, self.b = a, b
+
+    @property
+    def span(self) -> tuple[float, float]:
+        return math.radians(self.a), math.radians(self.b)
+
+    def __repr__(self) -> str:
+        return f"--range {self.a:g} {self.b:g}"
+
+
+class _RangeAction(argparse.Action):
+    """Parse ``--range A B`` into an :class:`InputRange` kept as the table's start (``args.start``):
+    the range fixes position 1 at A, so it excludes ``--start``."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        a, b = values
+        if not 0 < abs(b - a) < 360:
+            parser.error(f"argument --range: A and B must differ by more than 0 and less than 360 deg (a "
+                         f"full turn needs no range: use --start), got {a:g} {b:g}")
+        setattr(namespace, self.dest, InputRange(a, b))
+
+
+def _range_end(text: str) -> float:
+    try:
+        deg = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected an input angle in degrees, got {text!r}") from None
+    if not (math.isfinite(deg) and abs(deg) <= MAX_ANGLE_DEG):
+        raise argparse.ArgumentTypeError(f"expected a finite input angle in degrees with |x| <= "
+                                         f"{MAX_ANGLE_DEG:g}, got {text!r}")
+    return deg
+
+
 def _add_positions_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--positions", "-n", metavar="N", type=_positions, default=12,
-                   help="N equal steps per revolution; rows are positions 1..N+1 (default 12)")
-    p.add_argument("--start", metavar="extreme|DEG", type=_start, default="extreme",
-                   help="position 1: 'extreme' (default) = the extreme position of the scheme's "
-                        "output that starts the cycle ('max' / 'min' pick one), or an input angle "
-                        "in degrees")
+    p.add_argument("--positions", "-n", metavar="N", type=_positions, default=None,
+                   help="N equal steps per revolution (or over the input range); rows are positions "
+                        "1..N+1 (default: the scheme's [dynamics] positions, else 12)")
+    first = p.add_mutually_exclusive_group()
+    first.add_argument("--start", metavar="extreme|DEG", type=_start, default=None,
+                       help="position 1: 'extreme' = the extreme position of the scheme's output that "
+                            "starts the cycle ('max' / 'min' pick one), or an input angle in degrees "
+                            "(default: the scheme's [dynamics] start_deg, else 'extreme')")
+    first.add_argument("--range", metavar=("A", "B"), nargs=2, type=_range_end, dest="start",
+                       action=_RangeAction,
+                       help="analyse the input angles from A to B (deg) in N steps instead of a turn, "
+                            "for an input that does not turn fully (default: the scheme's range_deg, "
+                            "if any)")
 
 
-def _add_format_argument(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--format", "-f", choices=FORMATS, default="table",
-                   help="aligned text for people (default), CSV at full precision, or JSON")
+def _add_format_argument(p: argparse.ArgumentParser, formats: Sequence[str] = FORMATS) -> None:
+    p.add_argument("--format", "-f", choices=formats, default="table",
+                   help="aligned text for people (default; the columns that matter), CSV at full "
+                        "precision, or JSON (CSV and JSON: every column)")
+
+
+def _add_columns_argument(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--columns", "-c", metavar="LIST", default=None,
+                   help="the columns to give, after i and phi_deg, in every format: names and "
+                        "shell-style patterns separated by commas, e.g. 'B.*,3.theta'; '*' gives "
+                        "them all (default: the table for people shows the columns that matter, "
+                        "CSV and JSON every column)")
+
+
+def _scheme_defaults(mech, args) -> tuple[int, str | float]:
+    """The number of positions and the start of the table: the options, else the scheme's
+    [dynamics] positions and start_deg, else 12 positions from the output's extreme position."""
+    spec = _declared_dynamics(mech)
+    n = args.positions if args.positions is not None else spec.positions if spec is not None else 12
+    start = args.start if args.start is not None else spec.start if spec is not None else "extreme"
+    return n, start
+
+
+def _emit(columns: dict, args, meta: dict, default_view: Callable[[dict], list[str]] | None = None,
+          always: Sequence[str] = ("i", "phi_deg")) -> None:
+    """Print a table in ``args.format``: the columns ``--columns`` asks for; without it, every
+    column in CSV / JSON and ``default_view(columns)`` in the table for people (with one line
+    saying how to see the others)."""
+    units = units_of(columns)
+    if args.columns is not None:
+        try:
+            columns = select_columns(columns, args.columns, always=always)
+        except InputError as exc:
+            raise InputError(f"--columns {args.columns!r}: {exc}") from None
+    elif args.format == "table" and default_view is not None:
+        shown = default_view(columns)
+        if len(shown) < len(columns):
+            meta = {**meta, "columns": f"{len(shown)} of {len(columns)} shown; all of them: --columns '*' "
+                                       "(or --format csv / json)"}
+        columns = {name: columns[name] for name in shown}
+    if args.format == "json":
+        meta = {**meta, "conventions": "see `linkage --help` and docs/conventions.md"}
+    _out(format_columns(columns, args.format, meta=meta, units=units))
+
+
+def _constant(values) -> bool:
+    """All values equal to within 1e-12 of their magnitude (or all missing)."""
+    values = np.asarray(values, dtype=float)
+    finite = values[np.isfinite(values)]
+    return not len(finite) or float(np.ptp(finite)) <= 1e-12 * float(np.max(np.abs(finite)))
+
+
+def _same(a, b) -> bool:
+    """Two columns equal to within 1e-12 of their magnitude (missing values in the same rows)."""
+    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    if a.shape != b.shape or not np.array_equal(np.isfinite(a), np.isfinite(b)):
+        return False
+    ok = np.isfinite(a)
+    scale = max(float(np.max(np.abs(a[ok]), initial=0.0)), float(np.max(np.abs(b[ok]), initial=0.0)))
+    return bool(np.all(np.abs(a[ok] - b[ok]) <= 1e-12 * scale))
+
+
+def _fit(columns: dict, lead: Sequence[str], groups: Sequence[Sequence[str]], *,
+         skip_repeats: bool = False) -> list[str]:
+    """``lead`` and then the ``groups`` of column names, in order of priority, as long as the
+    table for people stays within :data:`TABLE_WIDTH` characters (names missing from ``columns``
+    are skipped; with ``skip_repeats``, so is a group whose columns are all constant, such as the
+    angle of a slider on a fixed guide, or repeat columns already shown, such as the slide of a
+    slider whose guide runs along x; a group that would not fit ends the selection)."""
+    shown = [name for name in lead if name in columns]
+    units = units_of(columns)
+    for group in groups:
+        extra = [name for name in group if name in columns and name not in shown]
+        if not extra or skip_repeats and all(
+                _constant(columns[name]) or any(_same(columns[name], columns[other]) for other in shown)
+                for name in extra):
+            continue
+        trial = shown + extra
+        if table_width({name: columns[name] for name in trial}, units) > TABLE_WIDTH:
+            break
+        shown = trial
+    return shown
 
 
 def _add_analyze(sub) -> None:
     p = sub.add_parser(
         "analyze", help="kinematics table: positions, velocity and acceleration analogs",
+        formatter_class=_HelpFormatter, epilog=CONVENTIONS,
         description="Positions and first / second transfer functions (analogs, d/dphi) of every "
                     "named point, moving link angle and prismatic slide, at N equal steps of the "
-                    "input angle phi (METHOD section 1). Columns: phi_deg; P.x P.y P.x' P.y' "
-                    "P.x'' P.y''; L.theta L.theta' L.theta''; K.s K.s' K.s'' (SI units: m, rad).")
+                    "input angle phi (docs/conventions.md). Columns: i, phi_deg; P.x P.y P.x' P.y' "
+                    "P.x'' P.y''; L.theta L.theta' L.theta''; K.s K.s' K.s'' (m, rad). The table "
+                    "for people shows the absolute input angle, the scheme's output and the "
+                    "moving links and slides with their analogs, as many as fit.")
     _add_scheme_argument(p)
     _add_positions_arguments(p)
+    _add_columns_argument(p)
     _add_format_argument(p)
     p.set_defaults(handler=_cmd_analyze)
 
 
+def _analyze_view(mech):
+    """The default columns of ``linkage analyze`` for people: the absolute input angle, the
+    output with its analogs, each other moving link's angle and each slide with their analogs,
+    then the coordinates of the moving points, as many as fit."""
+    def view(columns: dict) -> list[str]:
+        triple = lambda q: [q, q + "'", q + "''"]  # noqa: E731
+        groups = [[f"{link}.theta" for link in mech.inputs]]
+        if mech.output is not None:
+            groups.append(triple(mech.output.quantity))
+        groups += [triple(f"{link}.theta") for link in mech.moving_links if link not in mech.inputs]
+        groups += [triple(name) for name in columns if name.endswith(".s")]
+        moving = [p for p in mech.point_names if mech.point_link(p) != mech.frame]
+        groups += [[f"{p}.x", f"{p}.y"] for p in moving]
+        return _fit(columns, ("i", "phi_deg"), groups, skip_repeats=True)
+    return view
+
+
+def _table_sense(phi: np.ndarray) -> int:
+    """+1 / -1: the sense in which the table's input angles run (the ``direction`` that
+    ``phi = phi0 + direction * phi_deg`` holds with)."""
+    return -1 if len(phi) > 1 and phi[-1] < phi[0] else 1
+
+
+def _sense_in_words(direction: int) -> str:
+    return "counter-clockwise" if direction > 0 else "clockwise"
+
+
+def _start_line(mech, phi: np.ndarray, start, n: int, direction: int | None = None) -> str:
+    """The ``# start:`` line of a table for people: position 1 and how phi_deg counts (along the
+    table: in the direction of rotation over a turn, from A towards B over an input range)."""
+    sense = direction if direction is not None else (1 if len(phi) < 2 or phi[-1] >= phi[0] else -1)
+    phi0 = round(float(np.degrees(phi[0])), 10) + 0.0  # no round-off noise such as 5e-14 deg for 0
+    if start == "range":
+        end = round(float(np.degrees(phi[-1])), 10) + 0.0
+        sense = 1 if end >= phi0 else -1
+        return (f"phi0 = {phi0:.10g} deg (start of the input range); phi_deg counts from it "
+                f"{_sense_in_words(sense)} to {end:.10g} deg, {n} steps over the range")
+    where = ""
+    if isinstance(start, str) and mech.output is not None:
+        which = mech.output.start if start == "extreme" else start
+        where = f" ({which} of {mech.output.quantity})"
+    return (f"phi0 = {phi0:.10g} deg{where}; phi_deg counts from it {_sense_in_words(sense)}, "
+            f"{n} steps per revolution")
+
+
 def _table_positions(mech, n: int, start: str | float, direction: int) -> tuple[np.ndarray, str | float]:
-    """Input angles of the table (rad) and the start actually used."""
+    """Input angles of the table (rad) and the start actually used ("range" over an input range:
+    ``--range A B``, else the scheme's range_deg)."""
+    if isinstance(start, InputRange) or mech.input_range is not None:
+        if not (start is None or start == "extreme" or isinstance(start, InputRange)):
+            a, b = np.degrees(mech.input_range)
+            raise InputError(f"scheme '{mech.name}' declares range_deg = [{a:.10g}, {b:.10g}], which fixes "
+                             f"position 1 at {a:.10g} deg: --start {start} applies to a full turn (choose "
+                             "another range with --range A B)")
+        span = start.span if isinstance(start, InputRange) else None
+        return table_angles(mech, n, "extreme", direction, span=span), "range"
     if isinstance(start, str) and mech.output is None:
         _note("note", f"scheme '{mech.name}' declares no output, so it has no extreme position: "
                       "the table starts at phi = 0 deg (use --start DEG to choose)")
@@ -208,41 +463,31 @@ def _table_positions(mech, n: int, start: str | float, direction: int) -> tuple[
 def _cmd_analyze(args: argparse.Namespace) -> int:
     mech = load(args.scheme)
     direction = _rotation(mech)
+    n, start = _scheme_defaults(mech, args)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        phi, start = _table_positions(mech, args.positions, args.start, direction)
+        phi, start = _table_positions(mech, n, start, direction)
         motion = analyze(mech, phi, order=2, on_failure="mask")
         columns = motion.columns()
-    if not isinstance(start, str):
-        # label the rows with the angles as given (30, 60, ...), not their degrees(radians(...))
-        # round trip (29.999999999999996, ...); the difference is at the last digit
-        columns["phi_deg"] = start + direction * np.arange(len(phi)) * 360.0 / args.positions
     failed = _report_failures(motion)
     for w in caught:
         if issubclass(w.category, RuntimeWarning) and failed:
             continue  # numerical noise at the masked positions, reported above
         _note("warning", str(w.message))
-    phi0_deg = float(columns["phi_deg"][0])
     meta = {
         "scheme": mech.name,
         "description": mech.description,
         "formula": structure_of(mech).formula,
-        "positions": args.positions,
+        "positions": n,
         "start": start,
-        "phi0_deg": phi0_deg,
-        "direction": direction,
-        "units": "SI (m, rad); phi_deg in degrees; ' and '' are d/dphi and d2/dphi2",
+        "phi0_deg": float(np.degrees(phi[0])),
+        "direction": _table_sense(phi),
         "failed": failed,
     }
     if args.format == "table":
-        meta = {k: meta[k] for k in ("scheme", "formula")}
-        where = ""
-        if isinstance(start, str):
-            which = mech.output.start if start == "extreme" else start
-            where = f" ({which} of {mech.output.quantity})"
-        shown = round(phi0_deg, 10) + 0.0  # no round-off noise such as 5e-14 deg for 0
-        meta["start"] = f"phi0 = {shown:.10g} deg{where}, {args.positions} steps per revolution"
-    _out(format_columns(columns, args.format, meta=meta))
+        meta = {"scheme": mech.name, "formula": meta["formula"],
+                "start": _start_line(mech, phi, start, n, direction)}
+    _emit(columns, args, meta, _analyze_view(mech))
     return 0
 
 
@@ -251,16 +496,19 @@ def _report_failures(motion) -> list[dict]:
     from assur.base import CANNOT_ASSEMBLE, SINGULAR
 
     failed = []
+    travelled = table_positions_deg(motion.phi)
     phi_deg = np.degrees(motion.phi)
     for code, what, blank in ((CANNOT_ASSEMBLE, "cannot be assembled", "values are empty (nan)"),
                               (SINGULAR, "is singular", "analogs are empty (nan)")):
         where = np.flatnonzero(motion.status == code)
         if len(where):
+            numbers = ", ".join(str(i + 1) for i in where)
             shown = ", ".join(f"{phi_deg[i]:.6g}" for i in where)
-            _note("warning", f"mechanism '{motion.mechanism.name}' {what} at phi (deg) = {shown}: "
-                             f"{blank} in those rows")
+            _note("warning", f"mechanism '{motion.mechanism.name}' {what} at positions i = {numbers} "
+                             f"(input angle phi = {shown} deg): {blank} in those rows")
             for i in where:
-                entry = {"position": int(i) + 1, "phi_deg": float(phi_deg[i]), "problem": what}
+                entry = {"position": int(i) + 1, "phi_deg": float(travelled[i]),
+                         "input_angle_deg": float(phi_deg[i]), "problem": what}
                 if code == SINGULAR:  # the least conditioned group: its distance to the singularity
                     worst = min(motion.conditioning.items(), key=lambda kv: np.nan_to_num(kv[1][i], nan=2.0))
                     entry.update(group=worst[0], conditioning=float(worst[1][i]))
@@ -290,21 +538,34 @@ def _speed(args) -> float | None:
 def _add_forces(sub) -> None:
     p = sub.add_parser(
         "forces", help="kinetostatics: pair reactions and the balancing moment",
+        formatter_class=_HelpFormatter, epilog=CONVENTIONS,
         description="Reactions in every pair and the balancing moment on the input link at N "
                     "equal steps of phi, from the scheme's loads (gravity, external forces and "
-                    "diagrams) and the inertia loads of the given motion (METHOD section 5). "
-                    "Columns: phi_deg, balancing_moment (N m), and for each pair K: K.R (N) and "
-                    "K.angle_deg, the force R[a, b] that link b exerts on link a for the pair's "
-                    "links = [a, b]. JSON rows also carry K.Rx, K.Ry and, for prismatic pairs, "
-                    "K.M (N m, about the slider's point).")
+                    "diagrams) and the inertia loads of the given motion (docs/methods.md). "
+                    "Columns: i, phi_deg, balancing_moment (N m, CCW positive), and for each pair "
+                    "K: K.R (N) and K.angle_deg, the magnitude and direction of the force R[a, b] "
+                    "that link b exerts on link a for the pair's links = [a, b]; K.Rx, K.Ry (N) "
+                    "and, for prismatic pairs, K.M (N m, about the slider's point). The table for "
+                    "people shows the balancing moment and as many magnitudes and directions as "
+                    "fit.")
     _add_scheme_argument(p)
     _add_positions_arguments(p)
     _add_speed_arguments(p, "input angular velocity (default: the scheme's mean speed, else "
                             "none: a static analysis)")
     p.add_argument("--eps", metavar="RAD_S2", type=_real, default=0.0,
                    help="input angular acceleration, rad/s^2 (default 0)")
+    _add_columns_argument(p)
     _add_format_argument(p)
     p.set_defaults(handler=_cmd_forces)
+
+
+def _forces_view(columns: dict) -> list[str]:
+    """The default columns of ``linkage forces`` for people: the balancing moment, then the
+    magnitude of every reaction, then their directions, as many as fit, in table order."""
+    pairs = [name[:-2] for name in columns if name.endswith(".R")]
+    groups = [["balancing_moment"]] + [[f"{k}.R"] for k in pairs] + [[f"{k}.angle_deg"] for k in pairs]
+    shown = set(_fit(columns, ("i", "phi_deg"), groups))
+    return [name for name in columns if name in shown]
 
 
 def _cmd_forces(args: argparse.Namespace) -> int:
@@ -318,7 +579,8 @@ def _cmd_forces(args: argparse.Namespace) -> int:
         _note("note", "no speed given: omega = 0 with the given eps")
         omega = 0.0
     direction = _rotation(mech) if not omega else int(np.sign(omega))
-    phi, start = _table_positions(mech, args.positions, args.start, direction)
+    n, start = _scheme_defaults(mech, args)
+    phi, start = _table_positions(mech, n, start, direction)
     motion = analyze(mech, phi, order=2, omega=omega, eps=args.eps, on_failure="mask")
     failed = _report_failures(motion)
     ends = np.zeros(len(phi), bool)
@@ -327,15 +589,19 @@ def _cmd_forces(args: argparse.Namespace) -> int:
     for note in reactions.notes:
         _note("note", note)
     residual = virtual_power_residual(reactions)
-    columns = reactions.columns(full=args.format == "json")
+    columns = reactions.columns(full=True)
+    convention = "K.R, K.angle_deg: the force R[a, b] that link b exerts on link a (pair links = [a, b])"
     meta = {"scheme": mech.name, "formula": structure_of(mech).formula,
-            "omega": omega, "eps": args.eps, "positions": args.positions, "start": start,
-            "convention": "K.R = |R[a,b]|, the force link b exerts on link a (pair links = [a, b])",
+            "omega": omega, "eps": args.eps, "positions": n, "start": start,
+            "phi0_deg": float(np.degrees(phi[0])), "direction": _table_sense(phi), "convention": convention,
             "virtual_power_residual_max": float(np.nanmax(residual)) if np.isfinite(residual).any() else None,
             "failed": failed, "notes": list(reactions.notes)}
     if args.format == "table":
-        meta = {k: meta[k] for k in ("scheme", "omega", "eps", "virtual_power_residual_max")}
-    _out(format_columns(columns, args.format, meta=meta))
+        speed = "none (static analysis)" if omega is None else f"{omega:.6g} rad/s"
+        meta = {"scheme": mech.name, "start": _start_line(mech, phi, start, n, direction),
+                "omega": speed, "eps": f"{args.eps:.6g} rad/s^2", "convention": convention,
+                "virtual_power_residual_max": meta["virtual_power_residual_max"]}
+    _emit(columns, args, meta, _forces_view)
     return 0
 
 
@@ -347,14 +613,19 @@ def _cmd_forces(args: argparse.Namespace) -> int:
 def _add_dynamics(sub) -> None:
     p = sub.add_parser(
         "dynamics", help="machine dynamics: flywheel, law of motion, reactions under real motion",
-        description="The course pipeline (METHOD section 6): reduced moments and inertia, the "
+        formatter_class=_HelpFormatter, epilog=CONVENTIONS,
+        description="The course pipeline (docs/methods.md): reduced moments and inertia, the "
                     "constant driving moment, the flywheel for a coefficient of speed fluctuation "
                     "delta, the crank's omega(phi) and eps(phi), then the balancing moment under "
                     "that motion and the coefficient of dynamics max|M_b| / |M_d|. Methods: "
                     "'course' (Mertsalov, table positions), 'exact' (energy equation on a fine "
                     "grid, exact flywheel), 'ode' (equation of motion with the scheme's motor, "
-                    "steady state by shooting). Inputs come from the scheme's [dynamics] section; "
-                    "the options override them.")
+                    "steady state by shooting; without a motor, a constant driving moment, with a "
+                    "note). Inputs come from the scheme's [dynamics] section; the options override "
+                    "them. Columns: i, phi_deg, reduced_moment_resistance, reduced_moment_driving "
+                    "(N m), reduced_inertia (kg m^2, I_0 + I'' as declared), "
+                    "reduced_inertia_derivative (kg m^2/rad), omega (rad/s), eps (rad/s^2), "
+                    "balancing_moment (N m); with --transient: t (s), phi_deg, omega (rad/s).")
     _add_scheme_argument(p)
     p.add_argument("--positions", "-n", metavar="N", type=_positions, default=None,
                    help="N equal steps per revolution (default: the scheme's, else 12)")
@@ -363,31 +634,126 @@ def _add_dynamics(sub) -> None:
     _add_speed_arguments(p, "mean speed of the input link (default: the scheme's)")
     p.add_argument("--method", choices=("course", "exact", "ode"), default="course",
                    help="course (default), exact or ode")
-    p.add_argument("--format", "-f", choices=("table", "json"), default="table",
-                   help="aligned text (default) or JSON")
+    p.add_argument("--transient", action="store_true",
+                   help="with --method ode: give the start-up from the scheme's initial speed "
+                        "(t, phi_deg, omega at every step of the integration, over the scheme's "
+                        "cycles) instead of the per-position table")
+    _add_columns_argument(p)
+    _add_format_argument(p)
     p.set_defaults(handler=_cmd_dynamics)
 
 
+#: units of the scalar results of ``linkage dynamics`` (the ``# key: value`` lines of the table)
+_SUMMARY_UNITS = {
+    "driving_moment": "N m", "required_constant_inertia": "kg m^2", "flywheel_inertia": "kg m^2",
+    "mean_speed_actual": "rad/s", "constant_inertia": "kg m^2",
+    "exact_required_constant_inertia": "kg m^2", "exact_flywheel_inertia": "kg m^2",
+    "transient_time": "s", "settling_time": "s", "initial_speed": "rad/s",
+}
+
+
+def _dynamics_view(columns: dict) -> list[str]:
+    """The default columns of ``linkage dynamics`` for people: the law of motion, the balancing
+    moment, then the reduced characteristics, as many as fit, in table order."""
+    groups = [["omega"], ["eps"], ["balancing_moment"], ["reduced_moment_resistance"], ["reduced_inertia"],
+              ["reduced_moment_driving"], ["reduced_inertia_derivative"]]
+    shown = set(_fit(columns, ("i", "phi_deg", "t"), groups))
+    return [name for name in columns if name in shown]
+
+
 def _cmd_dynamics(args: argparse.Namespace) -> int:
-    from .dynamics import run_dynamics
+    from .dynamics import _override, run_dynamics, simulate
 
     mech = load(args.scheme)
+    if args.transient and args.method != "ode":
+        raise InputError(f"--transient: the start-up is a solution of the equation of motion with the "
+                         f"motor: give --method ode with it (got --method {args.method})")
+    declared = _declared_dynamics(mech)
+    spec = None
     if args.method == "ode":
-        _note("note", "sizing the flywheel (exact method), then shooting for the motor-driven "
-                      "steady state and integrating the start-up transient; this takes a few seconds")
-    report = run_dynamics(mech, args.method, positions=args.positions, delta=args.delta,
-                          mean_speed=_speed(args))
+        with _options_named(args):
+            spec = _override(mech, None, args.delta, _speed(args), args.positions)
+        if args.transient and spec.initial_speed is None:
+            raise InputError(f"--transient: scheme '{mech.name}' declares no speed to start from: give "
+                             "initial_rpm (or initial_speed, rad/s) in its [dynamics] section")
+        first = "sizing the flywheel (exact method), then " if spec.delta is not None else ""
+        then = " and integrating the start-up transient" if spec.initial_speed is not None else ""
+        _note("note", f"{first}shooting for the motor-driven steady state{then}; this takes a few seconds")
+    with _options_named(args):
+        report = run_dynamics(mech, args.method, positions=args.positions, delta=args.delta,
+                              mean_speed=_speed(args))
     for note in report.notes:
         _note("note", note)
-    summary = {"scheme": mech.name, **report.summary()}
-    if args.format == "json":
-        _out(format_columns(report.columns(), "json", meta=summary))
+    if spec is not None:
+        _ode_notes(mech, spec, report)
+    law = report.law
+    direction = law.reduced.rotation
+    n = len(law.phi) - 1
+    summary = {"scheme": mech.name, "positions": n, "phi0_deg": float(np.degrees(law.phi[0])),
+               "direction": direction, **report.summary()}
+    if args.transient:
+        transient = simulate(mech, spec, constant_inertia=law.constant_inertia)
+        columns = transient.columns()
+        summary.update(initial_speed=spec.initial_speed)
+        start = (f"t = 0 at phi0 = {round(float(np.degrees(law.phi[0])), 10) + 0.0:.10g} deg, "
+                 f"|omega| = {spec.initial_speed:.6g} rad/s; phi_deg counts from it "
+                 f"{_sense_in_words(direction)}, 360 per cycle, {spec.cycles} cycles")
+        always = ("t", "phi_deg")
     else:
+        columns = report.columns()
+        start = _start_line(mech, law.phi, declared.start if declared is not None else "extreme", n, direction)
+        always = ("i", "phi_deg")
+    if args.format == "table":
         in_words = {"flywheel_inertia": "none needed", "dynamic_coefficient": "undefined (see the note)"}
-        shown = {k: (f"{v:.6g}" if isinstance(v, float) else in_words[k] if v is None else v)
-                 for k, v in summary.items() if v is not None or k in in_words}
-        _out(format_columns(report.columns(), "table", meta=shown))
+        shown = {"scheme": mech.name, "start": start}
+        for k, v in summary.items():
+            if k in ("scheme", "positions", "phi0_deg", "direction") or (v is None and k not in in_words):
+                continue
+            text = f"{v:.6g}" if isinstance(v, float) else in_words[k] if v is None else str(v)
+            unit = _SUMMARY_UNITS.get(k) if v is not None else None
+            shown[k] = f"{text} {unit}" if unit else text
+        summary = shown
+    _emit(columns, args, summary, _dynamics_view, always=always)
     return 0
+
+
+@contextlib.contextmanager
+def _options_named(args):
+    """A refusal of a value the user gave as an option (``delta must be ...``) names the option
+    and the value as given on the command line (``--delta 5: delta must be ...``)."""
+    try:
+        yield
+    except InputError as exc:
+        text = str(exc)
+        speed = ("--rpm", args.rpm) if args.rpm is not None else ("--omega", args.omega)
+        for key, (option, value) in (("mean_speed", speed), ("delta", ("--delta", args.delta)),
+                                     ("positions", ("--positions", args.positions))):
+            if value is not None and text.startswith(key):
+                raise InputError(f"{option} {value:g}: {text}") from None
+        raise
+
+
+def _ode_notes(mech, spec, report) -> None:
+    """What the ode method assumed or found that a user must know: a constant driving moment
+    when the scheme declares no motor; a steady mean speed that misses the declared one by more
+    than delta."""
+    law = report.law
+    if spec.motor is None:
+        _note("note", f"scheme '{mech.name}' declares no [dynamics.motor]: --method ode drives the crank "
+                      f"with a constant moment, the cycle's mean driving moment {law.driving_moment:.6g} N m, "
+                      "so the steady state keeps the declared mean speed; declare a motor to use its "
+                      "characteristic")
+        return
+    actual = law.details.get("mean_speed")
+    declared = spec.mean_speed
+    if actual is None or spec.delta is None:
+        return
+    miss = abs(actual - declared) / abs(declared)
+    if miss > spec.delta:
+        _note("note", f"the motor's steady mean speed {actual:.4g} rad/s differs from the declared mean "
+                      f"speed {declared:.4g} rad/s by {100 * miss:.3g} %, more than delta = {spec.delta:g}: "
+                      "the flywheel was sized for the declared speed; check the motor's data in "
+                      "[dynamics.motor] (ratio, synchronous_rpm, rated_rpm ...) or the mean speed")
 
 
 # ----------------------------------------------------------------------------------------------
@@ -401,7 +767,8 @@ COMMANDS: list[Callable] = [_add_schemes, _add_analyze, _add_forces, _add_dynami
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog=PROG, description="Planar linkage analysis: Assur groups, exact kinematics, "
-                               "kinetostatics and machine dynamics.")
+                               "kinetostatics and machine dynamics.",
+        formatter_class=_HelpFormatter, epilog=CONVENTIONS)
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     for register in COMMANDS:
@@ -412,6 +779,7 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line with ``argv`` (default ``sys.argv[1:]``); return the exit status."""
     parser = build_parser()
+    _SAID.clear()  # each run says its notes once
     try:
         args = parser.parse_args(argv)
     except SystemExit as exc:  # --help, --version, usage errors (status 2)

@@ -1,4 +1,5 @@
-"""Machine dynamics of a one-degree-of-freedom mechanism (METHOD section 6).
+"""Machine dynamics of a one-degree-of-freedom mechanism (docs/methods.md, from
+"Reduced moment and moment of inertia" to "Coefficient of dynamics").
 
 Three ways to the crank's law of motion, all on any mechanism the graph can express:
 
@@ -33,10 +34,11 @@ from scipy.optimize import brentq
 
 from .errors import DynamicsError, DynamicsInputError, LinkageError, SchemeError
 from .extremes import extreme_positions, table_angles
-from .kinematics import analyze
+from .kinematics import analyze, table_positions_deg
 from .kinetostatics import solve_reactions
-from .model import MAX_POSITIONS, Mechanism, _is_number, check_number, unknown_keys
-from .motors import RPM, ConstantMotor, motor_from_spec
+from .model import (MAX_MAGNITUDE, MAX_POSITIONS, MIN_MAGNITUDE, Mechanism, _is_number, check_number,
+                    unknown_keys)
+from .motors import RPM, ConstantMotor, motor_from_spec, starting_moment
 from .reduced import Reduced, reduced_characteristics
 from .scheme import register_section, section_of
 
@@ -112,8 +114,8 @@ def _check_spec(spec: DynamicsSpec) -> DynamicsSpec:
         _require(ok, f"rotors[{i}]", rotor, "(inertia >= 0 in kg m^2, finite gear ratio U)")
     _require(math.isfinite(spec.constant_inertia), "the constant inertia inertia_0 + sum(J U^2) + flywheel",
              spec.constant_inertia, "finite in float64 (kg m^2)")
-    _require(spec.initial_speed is None or (_real(spec.initial_speed) and spec.initial_speed > 0), "initial_speed",
-             spec.initial_speed, "a finite number > 0 (|omega| at the start, rad/s)")
+    _require(spec.initial_speed is None or (_real(spec.initial_speed) and spec.initial_speed >= 0), "initial_speed",
+             spec.initial_speed, "a finite number >= 0 (|omega| at the start, rad/s; 0: from rest)")
     _require(spec.motor is None or callable(spec.motor), "motor", spec.motor,
              "a motor characteristic motor(w) -> M (linkage.motors)")
     return spec
@@ -157,7 +159,8 @@ class DynamicsSpec:
     motor : callable or None
         Motor characteristic reduced to the input (:mod:`linkage.motors`).
     initial_speed : float or None
-        Initial |omega| of the start-up transient, rad/s.
+        Initial |omega| of the start-up transient, rad/s; 0 starts from rest (the motor needs a
+        starting torque, see :func:`simulate`).
     cycles : int
         Cycles of the start-up transient.
     """
@@ -234,8 +237,14 @@ def parse_dynamics(mech: Mechanism, raw: Mapping[str, Any] | None) -> tuple[Dyna
     for key, largest in (("positions", MAX_POSITIONS), ("cycles", MAX_CYCLES)):
         if key in raw:
             args[key] = _count(raw, key, largest, problems)
-    if "start_deg" in raw:
+    if "start_deg" in raw and mech.input_range is not None:
+        a, b = np.degrees(mech.input_range)
+        problems.append(f"start_deg = {raw['start_deg']!r}: the scheme declares range_deg = [{a:.10g}, {b:.10g}], "
+                        f"whose first end ({a:.10g} deg) is position 1; start_deg applies to a full turn")
+    elif "start_deg" in raw:
         args["start"] = check_number(raw["start_deg"], "", "start_deg", problems, "angle_deg", "deg")
+    elif mech.input_range is not None:
+        pass  # position 1 is the range's first end
     elif mech.output is None:
         problems.append("the cycle starts at the output's extreme position: declare an output "
                         "or start_deg")
@@ -262,15 +271,30 @@ def parse_dynamics(mech: Mechanism, raw: Mapping[str, Any] | None) -> tuple[Dyna
         if inertia is not None and ratio is not None:
             rotors.append((inertia, ratio))
     args["rotors"] = tuple(rotors)
-    if "initial_speed" in raw or "initial_rpm" in raw:
-        key = "initial_speed" if "initial_speed" in raw else "initial_rpm"
-        v = check_number(raw[key], "", f"{key} (|omega| at the start)", problems, "positive",
-                         "rad/s" if key == "initial_speed" else "rpm")
-        args["initial_speed"] = v * (RPM if key == "initial_rpm" else 1.0) if v else None
+    start_key = None
+    if "initial_speed" in raw and "initial_rpm" in raw:
+        problems.append("give either initial_speed (rad/s) or initial_rpm (rpm), not both")
+    elif "initial_speed" in raw or "initial_rpm" in raw:
+        start_key = "initial_speed" if "initial_speed" in raw else "initial_rpm"
+        v = raw[start_key]
+        unit = "rad/s" if start_key == "initial_speed" else "rpm"
+        if _is_number(v) and (v == 0 or MIN_MAGNITUDE <= v <= MAX_MAGNITUDE):
+            args["initial_speed"] = float(v) * (RPM if start_key == "initial_rpm" else 1.0)
+        else:
+            problems.append(f"{start_key} (|omega| at the start of the transient) must be 0 (from rest) or a "
+                            f"number in [{MIN_MAGNITUDE:g}, {MAX_MAGNITUDE:g}] {unit}, got {v!r}")
     if "motor" in raw:
         motor, motor_problems = motor_from_spec(raw["motor"])
         problems += motor_problems
         args["motor"] = motor
+        if motor is not None and args.get("initial_speed") == 0:
+            m0 = starting_moment(motor)
+            if not m0 > 0:
+                kind = raw["motor"].get("kind")
+                problems.append(f"{start_key} = {raw[start_key]!r} starts from rest, but the {kind} "
+                                f"motor has no starting torque: its moment at rest is {m0:.6g} N m at the input "
+                                "(a start from rest needs one > 0: a linear motor with stall_moment > 0, an "
+                                "induction motor); give a start speed > 0")
     return (DynamicsSpec(**args) if not problems else None), problems
 
 
@@ -350,6 +374,18 @@ class LawOfMotion:
         return float(np.sign(self.omega[0]) * (np.max(np.abs(self.omega)) + np.min(np.abs(self.omega))) / 2)
 
 
+def _require_full_turn(mech: Mechanism, what: str) -> None:
+    """DynamicsInputError when ``mech`` is analysed over a partial input range: ``what`` (a cycle
+    of the machine's dynamics) needs its input to turn fully."""
+    if mech.input_range is not None:
+        a, b = np.degrees(mech.input_range)
+        raise DynamicsInputError(
+            f"mechanism '{mech.name}': {what} needs the input to turn fully (one cycle is one turn), but the "
+            f"scheme declares range_deg = [{a:.10g}, {b:.10g}]: its input turns only over that range. Its "
+            "kinematics and forces are analysed over the range ('linkage analyze', 'linkage forces'); for "
+            "the cycle dynamics leave range_deg out of a mechanism whose input turns fully")
+
+
 def _cycle(mech: Mechanism, spec: DynamicsSpec, positions: int | None = None):
     n = spec.positions if positions is None else positions
     phi = table_angles(mech, n, spec.start, spec.rotation)
@@ -359,7 +395,7 @@ def _cycle(mech: Mechanism, spec: DynamicsSpec, positions: int | None = None):
 
 
 def _eps(reduced: Reduced, driving: float | np.ndarray, inertia: np.ndarray, w: np.ndarray) -> np.ndarray:
-    """``s (M_d + M_c - dI/dpsi w^2 / 2) / I`` (METHOD section 6)."""
+    """``s (M_d + M_c - dI/dpsi w^2 / 2) / I`` (docs/methods.md, "Mertsalov's method")."""
     return reduced.rotation * (driving + reduced.moment - 0.5 * reduced.inertia_derivative * w**2) / inertia
 
 
@@ -370,7 +406,7 @@ def _eps(reduced: Reduced, driving: float | np.ndarray, inertia: np.ndarray, w: 
 
 def course_method(mech: Mechanism, spec: DynamicsSpec | None = None, *, positions: int | None = None,
                   delta: float | None = None, mean_speed: float | None = None) -> LawOfMotion:
-    """Mertsalov's method on the table positions (METHOD section 6).
+    """Mertsalov's method on the table positions (docs/methods.md, "Mertsalov's method").
 
     ``positions``, ``delta`` and ``mean_speed`` override the declared inputs. The method is plain
     arithmetic on the table (no tolerance): a consistently scaled machine gives results scaled
@@ -385,6 +421,7 @@ def course_method(mech: Mechanism, spec: DynamicsSpec | None = None, *, position
     DynamicsError
         The machine has no inertia at the crank and needs none, so its speed is undetermined.
     """
+    _require_full_turn(mech, "the course method (Mertsalov)")
     spec = _override(mech, spec, delta, mean_speed, positions)
     if spec.delta is None:
         raise DynamicsInputError(f"mechanism '{mech.name}': the course method needs delta (the coefficient of "
@@ -534,6 +571,7 @@ def exact_method(mech: Mechanism, spec: DynamicsSpec | None = None, *, positions
         No constant inertia gives the mean speed (without ``delta``), or the machine has no
         inertia and no energy swing (its speed is undetermined).
     """
+    _require_full_turn(mech, "the exact energy method")
     spec = _override(mech, spec, delta, mean_speed, positions)
     _require_count("samples", samples)
     if spec.delta is not None and spec.delta < DELTA_RESOLVED:
@@ -615,6 +653,14 @@ class Transient:
     sol: Any
     message: str = ""
 
+    def columns(self) -> dict[str, np.ndarray]:
+        """The start-up as a table, one row per output point of the solver: ``t`` (s, from the
+        start), ``phi_deg`` (the crank angle travelled from the start in the direction of
+        rotation, deg; ``psi`` in degrees, so it grows by 360 per cycle), ``omega`` (rad/s,
+        signed)."""
+        return {"t": np.asarray(self.t, dtype=float), "phi_deg": np.degrees(self.psi),
+                "omega": np.asarray(self.omega, dtype=float)}
+
 
 class _Equation:
     """``I(psi) w dw/dpsi + I'(psi) w^2 / 2 = M_d(w) + M(psi)`` in the energy form
@@ -672,8 +718,9 @@ class _Energy:
 
 
 def _integrate(eq: _Equation, energy0: float, cycles: float, rtol: float, atol: float | None,
-               speed_limit: float) -> Any:
-    """``solve_ivp`` (RK45) over ``cycles`` from the kinetic energy ``energy0``.
+               speed_limit: float, psi0: float = 0.0, t0: float = 0.0) -> Any:
+    """``solve_ivp`` (RK45) from ``psi0`` (time ``t0``) to ``2 pi cycles`` from the kinetic energy
+    ``energy0``.
 
     The state is ``[T - energy0, t]``: the energy's change, not its level, so the changes (the
     work of the loads, the swing within a cycle) are resolved to ``rtol`` relative and ``atol``
@@ -689,7 +736,7 @@ def _integrate(eq: _Equation, energy0: float, cycles: float, rtol: float, atol: 
                             "positive number")
     floor = 1e-10 * energy0
     energy_tol = rtol * (eq.work if 0 < eq.work < energy0 else energy0)
-    time_tol = 1e-10 * 2 * np.pi / float(eq.speed(0.0, energy0))
+    time_tol = 1e-10 * 2 * np.pi / float(eq.speed(psi0, energy0))
 
     def rhs(psi, y):
         return eq.rhs(psi, (energy0 + y[0], y[1]))
@@ -703,7 +750,7 @@ def _integrate(eq: _Equation, energy0: float, cycles: float, rtol: float, atol: 
         return eq.speed(psi, energy0 + y[0]) - speed_limit
 
     runaway.terminal, runaway.direction = True, 1
-    sol = solve_ivp(rhs, (0.0, 2 * np.pi * cycles), [0.0, 0.0], method="RK45", rtol=rtol,
+    sol = solve_ivp(rhs, (psi0, 2 * np.pi * cycles), [0.0, t0], method="RK45", rtol=rtol,
                     atol=[atol if atol is not None else energy_tol, time_tol],
                     dense_output=True, events=[stall, runaway], max_step=2 * np.pi / 90)
     if sol.sol is not None:
@@ -768,30 +815,155 @@ def simulate(mech: Mechanism, spec: DynamicsSpec | None = None, *, initial_speed
     measured on the flying shears, the energy at rtol = 1e-9 is within 250 rtol of a run at
     1e-13.
 
+    ``initial_speed = 0`` starts from rest, which needs a motor with a starting torque (its
+    moment at rest > 0: any induction motor, a linear motor with ``stall_moment > 0``, a positive
+    constant moment). The energy form's ``dt/dpsi = 1 / omega`` is singular at omega = 0, so the
+    first :data:`REST_START_ANGLE` (1 deg) of rotation is integrated in time,
+    ``I(psi) domega/dt = M_d(omega) + M(psi) - I'(psi) omega^2 / 2``, ``dpsi/dt = omega``
+    (RK45, ``rtol``), from ``psi = omega = 0``; the energy form takes over from there.
+
     Raises
     ------
     DynamicsInputError
-        An argument out of range: ``initial_speed`` not a finite number > 0, ``cycles`` < 1,
+        An argument out of range: ``initial_speed`` not a finite number >= 0 (or 0 with a motor
+        that has no starting torque), ``cycles`` < 1,
         ``rtol`` outside [2.2e-14, 1), ``atol`` <= 0, ``samples`` < 1, ``constant_inertia`` < 0,
         or a declared input out of range.
     DynamicsError
-        On stall or run-away, or when the kinetic energy overflows float64.
+        On stall or run-away (or a start from rest whose starting torque does not overcome the
+        resistance at position 1), or when the kinetic energy overflows float64; a mechanism
+        analysed over a partial input range (``range_deg``) has no cycle (DynamicsInputError).
     """
+    _require_full_turn(mech, "the start-up transient")
     spec = _check_spec(dynamics_of(mech) if spec is None else spec)
     w0 = initial_speed if initial_speed is not None else spec.initial_speed
-    _require(_real(w0) and w0 > 0, "initial_speed", w0, "a finite number > 0 (|omega| at the start of the "
-                                                       "transient, rad/s)")
+    _require(_real(w0) and w0 >= 0, "initial_speed", w0, "a finite number >= 0 (|omega| at the start of the "
+                                                        "transient, rad/s; 0: from rest)")
     if cycles is not None:
         _require_count("cycles", cycles)
     _check_ode_args(rtol, atol, samples, constant_inertia)
     constant = _default_constant(mech, spec) if constant_inertia is None else float(constant_inertia)
     eq = _Equation(mech, spec, None, constant, samples)
     eq.motor = _motor_of(spec, eq.cycle.driving)
-    energy0 = _kinetic_energy(float(eq.inertia(0.0)), w0, f"mechanism '{mech.name}' transient (initial_speed)")
-    sol = _integrate(eq, energy0, cycles or spec.cycles, rtol, atol, _speed_limit(spec, eq.motor))
-    _raise_events(sol, eq, f"mechanism '{mech.name}' transient")
+    name = f"mechanism '{mech.name}' transient"
+    limit = _speed_limit(spec, eq.motor)
+    if w0 == 0:
+        return _from_rest(eq, spec, cycles or spec.cycles, rtol, atol, limit, name,
+                          declared=spec.motor is not None)
+    energy0 = _kinetic_energy(float(eq.inertia(0.0)), w0, f"{name} (initial_speed)")
+    sol = _integrate(eq, energy0, cycles or spec.cycles, rtol, atol, limit)
+    _raise_events(sol, eq, name)
     w = eq.speed(sol.t, energy0 + sol.y[0])
     return Transient(sol.t, sol.y[1], spec.rotation * w, sol.sol, sol.message)
+
+
+#: A start from rest is integrated in time over its first REST_START_ANGLE (rad, 1 deg) of input
+#: rotation, where the energy form's dt/dpsi = 1 / omega is singular at omega = 0; the energy
+#: form in psi takes over from there (omega is then well above zero).
+REST_START_ANGLE = 2 * np.pi / 360
+
+
+def _from_rest(eq: _Equation, spec: DynamicsSpec, cycles: int, rtol: float, atol: float | None,
+               limit: float, name: str, declared: bool) -> Transient:
+    """The start-up transient from omega = 0: the equation of motion in time,
+    ``I(psi) dw/dt = M_d(w) + M(psi) - I'(psi) w^2 / 2`` and ``dpsi/dt = w`` from ``psi = w = 0``
+    up to ``psi = REST_START_ANGLE``, then the energy form in psi (:func:`_integrate`)."""
+    starting = starting_moment(eq.motor)
+    if not starting > 0:
+        what = (f"the motor's moment at rest is {starting:.6g} N m at the input" if declared else
+                f"no motor is declared and the constant driving moment that balances the cycle is "
+                f"{starting:.6g} N m")
+        raise DynamicsInputError(f"{name}: initial_speed = 0 (a start from rest) needs a starting torque, but "
+                                 f"{what}; declare a motor with one (a linear motor with stall_moment > 0, an "
+                                 "induction motor) or a start speed > 0")
+    resisting = float(eq.moment(0.0))
+    i0 = float(eq.inertia(0.0))
+    accel = (starting + resisting) / i0
+    if not accel > 0:
+        raise DynamicsError(f"{name}: the machine does not start from rest: the starting torque {starting:.6g} N m "
+                            f"does not overcome the resisting moment {-resisting:.6g} N m at the cycle's start "
+                            "(position 1)")
+    slope = eq.inertia.derivative()
+    t_scale = math.sqrt(2 * REST_START_ANGLE / accel)  # time to the switch at the initial acceleration
+    w_scale = accel * t_scale
+
+    def rhs(t, y):
+        psi, w = y
+        at = np.mod(psi, 2 * np.pi)
+        driving = float(np.asarray(eq.motor(w), dtype=float))
+        if not math.isfinite(driving):
+            raise DynamicsError(f"{name}: the motor's moment at |omega| = {w:.6g} rad/s is {driving!r}, not a "
+                                "finite number")
+        return [w, (driving + float(eq.moment(psi)) - 0.5 * float(slope(at)) * w * w) / float(eq.inertia(at))]
+
+    def switch(t, y):
+        return y[0] - REST_START_ANGLE
+
+    def stall(t, y):
+        return y[1]
+
+    def runaway(t, y):
+        return y[1] - limit
+
+    switch.terminal, switch.direction = True, 1
+    stall.terminal, stall.direction = True, -1
+    runaway.terminal, runaway.direction = True, 1
+    first = solve_ivp(rhs, (0.0, 1e6 * t_scale), [0.0, 0.0], method="RK45", rtol=rtol,
+                      atol=[1e-3 * rtol * REST_START_ANGLE, 1e-3 * rtol * w_scale], dense_output=True,
+                      events=[switch, stall, runaway], max_step=t_scale / 10)
+    if first.status == -1:
+        raise DynamicsError(f"{name}: the integration from rest failed ({first.message})")
+    if len(first.t_events[1]):
+        raise DynamicsError(f"{name}: the machine stalls (omega -> 0) after {first.t_events[1][0]:.3g} s, within "
+                            f"the first {math.degrees(REST_START_ANGLE):g} deg from rest: the motor cannot "
+                            "overcome the load")
+    if len(first.t_events[2]):
+        raise DynamicsError(f"{name}: the machine runs away (|omega| above the speed limit) within the first "
+                            f"{math.degrees(REST_START_ANGLE):g} deg from rest")
+    if not len(first.t_events[0]):
+        raise DynamicsError(f"{name}: the machine does not turn {math.degrees(REST_START_ANGLE):g} deg from rest "
+                            f"within {first.t[-1]:.3g} s")
+    t_switch = float(first.t_events[0][0])
+    psi_switch, w_switch = (float(v) for v in first.y_events[0][0])
+    energy = _kinetic_energy(float(eq.inertia(psi_switch)), w_switch, name)
+    sol = _integrate(eq, energy, cycles, rtol, atol, limit, psi0=psi_switch, t0=t_switch)
+    _raise_events(sol, eq, name)
+    keep = first.t < t_switch
+    psi = np.concatenate([first.y[0][keep], sol.t])
+    t = np.concatenate([first.t[keep], sol.y[1]])
+    w = np.concatenate([first.y[1][keep], eq.speed(sol.t, energy + sol.y[0])])
+    return Transient(psi, t, spec.rotation * w, _RestStart(first.sol, t_switch, psi_switch, eq, sol.sol),
+                     sol.message)
+
+
+class _RestStart:
+    """The dense solution ``psi -> [T, t]`` of a start from rest: before the switch angle from the
+    integration in time (``t(psi)`` by inverting its monotonic ``psi(t)``), after it from the
+    energy form."""
+
+    def __init__(self, in_time, t_switch: float, psi_switch: float, eq: _Equation, after):
+        self.in_time, self.psi_switch, self.eq, self.after = in_time, psi_switch, eq, after
+        self.t_grid = np.linspace(0.0, t_switch, 2001)
+        self.psi_grid = in_time(self.t_grid)[0]
+
+    def __call__(self, psi):
+        psi = np.asarray(psi, dtype=float)
+        out = np.array(self.after(np.maximum(psi, self.psi_switch)), dtype=float)
+        early = psi < self.psi_switch
+        if np.any(early):
+            target = psi[early] if psi.ndim else psi
+            t = np.interp(target, self.psi_grid, self.t_grid)
+            for _ in range(4):  # Newton on psi(t) = target (dpsi/dt = omega > 0 after the start)
+                at, w = self.in_time(t)
+                t = np.where(w > 0, t - (at - target) / np.where(w > 0, w, 1.0), t)
+            t = np.clip(t, 0.0, self.t_grid[-1])
+            w = self.in_time(t)[1]
+            energy = 0.5 * self.eq.inertia(np.mod(psi[early] if psi.ndim else psi, 2 * np.pi)) * w * w
+            if psi.ndim:
+                out[0][early], out[1][early] = energy, t
+            else:
+                out = np.array([energy, t], dtype=float)
+        return out
 
 
 def _default_constant(mech: Mechanism, spec: DynamicsSpec) -> float:
@@ -830,6 +1002,7 @@ def steady_state(mech: Mechanism, spec: DynamicsSpec | None = None, *, constant_
         When the machine stalls, runs away, no periodic solution is found, or the kinetic energy
         overflows float64.
     """
+    _require_full_turn(mech, "the steady state of the equation of motion")
     spec = _check_spec(dynamics_of(mech) if spec is None else spec)
     if positions is not None:
         spec = _check_spec(replace(spec, positions=positions))
@@ -924,11 +1097,16 @@ class DynamicsReport:
     notes: tuple[str, ...] = ()
 
     def columns(self) -> dict[str, np.ndarray]:
-        """Per position: ``phi_deg``, ``reduced_moment_resistance``, ``reduced_moment_driving``,
-        ``reduced_inertia``, ``reduced_inertia_derivative``, ``omega``, ``eps``, ``balancing_moment``."""
+        """Per position: ``i`` (from 1), ``phi_deg`` (the crank angle travelled from the cycle's
+        start in the direction of rotation, deg: 0 .. 360), ``reduced_moment_resistance`` and
+        ``reduced_moment_driving`` (N m, positive when they drive), ``reduced_inertia`` (kg m^2,
+        the machine as declared: ``I_0 + I''``, without a flywheel the method adds),
+        ``reduced_inertia_derivative`` (dI/dpsi, kg m^2/rad), ``omega`` (rad/s, signed), ``eps``
+        (rad/s^2), ``balancing_moment`` (N m, under that motion)."""
         red = self.law.reduced
         return {
-            "phi_deg": np.degrees(self.law.phi),
+            "i": np.arange(1, len(self.law.phi) + 1),
+            "phi_deg": table_positions_deg(self.law.phi),
             "reduced_moment_resistance": red.moment_resistance,
             "reduced_moment_driving": red.moment_driving,
             "reduced_inertia": red.inertia,
@@ -978,6 +1156,7 @@ def run_dynamics(mech: Mechanism, method: str = "course", *, positions: int | No
     DynamicsError
         See the method's function.
     """
+    _require_full_turn(mech, "the machine's dynamics")
     if method not in ("course", "exact", "ode"):
         raise DynamicsInputError(f"method must be 'course', 'exact' or 'ode', got {method!r}")
     spec = _override(mech, None, delta, mean_speed, positions)

@@ -1,7 +1,9 @@
 """Extreme positions of an output coordinate and the input angles of position tables.
 
-An extreme position is a root of the output's first analog ``q'(phi) = 0`` (METHOD section 7),
-found by bracketing on a sweep and refining with Brent's method to ~1e-13 rad.
+An extreme position is a root of the output's first analog ``q'(phi) = 0`` (docs/methods.md,
+"Extreme positions and table positions"), found by bracketing on a sweep and refining with Brent's
+method to ~1e-13 rad. Over a mechanism's input range (``range_deg``) the range's ends are
+candidates too.
 
 >>> import math, linkage
 >>> ext = linkage.extreme_positions(linkage.load("slider_crank"), "B.x")
@@ -31,11 +33,12 @@ class Extremes:
     ----------
     quantity : str
     phi_max, phi_min : float
-        Input angles (rad, in [0, 2 pi)) where the quantity is largest / smallest.
+        Input angles (rad, in [0, 2 pi); within the mechanism's ``input_range`` when it declares
+        one) where the quantity is largest / smallest.
     value_max, value_min : float
         The quantity there (m or rad).
     roots : ndarray
-        Every root of the first analog found in [0, 2 pi), sorted.
+        Every root of the first analog found in [0, 2 pi) (within the input range), sorted.
     """
 
     quantity: str
@@ -68,6 +71,11 @@ def extreme_positions(mech: Mechanism, quantity: str | None = None, *, samples: 
                       xtol: float = 1e-14) -> Extremes:
     """Find the extreme positions of ``quantity`` (default: the mechanism's declared output).
 
+    Over a revolution, the extremes are roots of the first analog. A mechanism with an
+    ``input_range`` is searched within the range only: its extremes are the largest and smallest
+    values among the roots inside the range and the range's two ends (an output that is monotonic
+    over the range has its extremes at the ends).
+
     Parameters
     ----------
     mech : Mechanism
@@ -94,6 +102,9 @@ def extreme_positions(mech: Mechanism, quantity: str | None = None, *, samples: 
 def _find_extremes(mech: Mechanism, quantity: str, samples: int, xtol: float) -> Extremes:
     def derivative(phi: float) -> float:
         return analyze(mech, [phi], order=1, outputs=[quantity]).quantity(quantity)[1][0]
+
+    if mech.input_range is not None:
+        return _find_extremes_in_range(mech, quantity, samples, xtol, derivative)
 
     grid = np.linspace(0.0, 2 * np.pi, samples, endpoint=False)
     motion = analyze(mech, grid, order=1, outputs=[quantity], on_failure="mask")
@@ -123,9 +134,50 @@ def _find_extremes(mech: Mechanism, quantity: str, samples: int, xtol: float) ->
                     float(values[i_min]), roots)
 
 
+def _find_extremes_in_range(mech: Mechanism, quantity: str, samples: int, xtol: float,
+                            derivative) -> Extremes:
+    """Extremes within ``mech.input_range``: among the roots of the analog inside it (found as
+    over a turn, without wrapping) and the range's two ends."""
+    lo, hi = sorted(mech.input_range)
+    grid = np.linspace(lo, hi, samples + 1)
+    motion = analyze(mech, grid, order=1, outputs=[quantity], on_failure="mask")
+    value, d1, _ = motion.quantity(quantity)
+    if not np.isfinite(d1).any():
+        raise InputError(f"mechanism '{mech.name}' cannot be assembled at any input angle of its range")
+    scale = 1.0 if quantity.endswith(".theta") else mech.size
+    if not np.nanmax(np.abs(d1)) > 1e-12 * scale:
+        raise InputError(f"'{quantity}' of mechanism '{mech.name}' does not move over the input range: it "
+                         "has no extreme positions")
+    valid = np.isfinite(d1[:-1]) & np.isfinite(d1[1:])
+    roots = list(grid[np.flatnonzero(np.isfinite(d1) & (d1 == 0.0))])
+    for i in np.flatnonzero(valid & (d1[:-1] * d1[1:] < 0)):
+        roots.append(brentq(derivative, grid[i], grid[i + 1], xtol=xtol, rtol=4 * np.finfo(float).eps))
+    roots = np.unique(roots)
+    candidates = np.concatenate([[lo, hi], roots])
+    values = analyze(mech, candidates, order=0, outputs=[quantity], on_failure="mask").quantity(quantity)[0]
+    if quantity.endswith(".theta"):  # angles: continuous over the range, across the +-pi cut
+        values = _unwrapped_at(grid, value, candidates, values)
+    i_max, i_min = int(np.nanargmax(values)), int(np.nanargmin(values))
+    return Extremes(quantity, float(candidates[i_max]), float(candidates[i_min]), float(values[i_max]),
+                    float(values[i_min]), roots)
+
+
+def _unwrapped_at(grid, value, phi, found):
+    """The angles ``found`` at ``phi`` on the continuous branch of ``value`` sampled on ``grid``."""
+    smooth = np.unwrap(value)
+    near = np.interp(phi, grid, smooth)
+    return near + wrap_angle(found - near)
+
+
 def table_angles(mech: Mechanism, n: int = 12, start: str | float = "extreme", direction: int = 1,
-                 quantity: str | None = None) -> np.ndarray:
-    """Input angles ``phi_i = phi0 + direction (i - 1) 2 pi / n``, i = 1..n+1 (METHOD section 1).
+                 quantity: str | None = None, *, span: tuple[float, float] | None = None) -> np.ndarray:
+    """Input angles ``phi_i = phi0 + direction (i - 1) 2 pi / n``, i = 1..n+1 (docs/conventions.md,
+    "Table positions").
+
+    Over an input range ``(a, b)`` (rad: ``span``, default the mechanism's ``input_range``) the
+    angles are ``phi_i = a + (i - 1) (b - a) / n`` instead: the table runs from a to b as written,
+    whatever ``direction``; ``start`` must then be ``"extreme"`` (the default), since the range
+    fixes position 1.
 
     Parameters
     ----------
@@ -140,6 +192,17 @@ def table_angles(mech: Mechanism, n: int = 12, start: str | float = "extreme", d
     """
     if n < 1:
         raise InputError(f"the number of positions must be >= 1, got {n}")
+    span = mech.input_range if span is None else span
+    if span is not None:
+        a, b = (float(v) for v in span)
+        if not (np.isfinite(a) and np.isfinite(b) and 0 < abs(b - a) < 2 * np.pi):
+            raise InputError(f"an input range must be two finite angles that differ by more than 0 and less "
+                             f"than a full turn, got {np.degrees(a):.10g}, {np.degrees(b):.10g} deg")
+        if not (isinstance(start, str) and start == "extreme"):
+            raise InputError(f"mechanism '{mech.name}' is analysed over the input range [{np.degrees(a):.10g}, "
+                             f"{np.degrees(b):.10g}] deg, which fixes position 1 at its first end: a start "
+                             f"({start!r}) applies only to a full turn")
+        return a + (b - a) * np.arange(n + 1) / n
     if direction not in (1, -1):
         raise InputError(f"direction must be +1 or -1, got {direction!r}")
     if isinstance(start, str):

@@ -1,6 +1,6 @@
 """Loads on a mechanism: gravity, inertia, external forces and moments, force diagrams.
 
-METHOD sections 5 and 7. A :class:`Loads` collects what acts on the links; given a
+docs/methods.md, "Loads". A :class:`Loads` collects what acts on the links; given a
 :class:`~linkage.kinematics.Motion` with real speeds it is evaluated into per-position
 :class:`LoadTerm` s (a force at a point of a link and a moment on the link), which the
 kinetostatics and the dynamics consume.
@@ -20,13 +20,30 @@ Declared in scheme files as::
     link = "3"
     diagram = { along = "x", working = "+", fractions = [0, 0.5, 1], values = [0, 800, 0] }
 
+    [[loads.forces]]                  # a step diagram: a repeated fraction is a jump
+    point = "E"
+    link = "2"
+    diagram.along = "y"
+    diagram.working = "-"
+    diagram.fractions = [0, 0.3, 0.3, 0.6, 0.6, 1]
+    diagram.values = [0, 0, 2100, 2100, 0, 0]
+
+    [[loads.forces]]                  # a directed force: along the line C -> D (cylinder axis)
+    point = "D"
+    link = "4"
+    between = ["C", "D"]              # positive pushes from C towards D
+    magnitude = 1500.0                # N, signed (or diagram = {quantity = ...} / cycle = [...])
+
     [[loads.moments]]                 # a moment on link 3, N m, CCW positive
     link = "3"
     moment = -5.0
+
+The full format (every key, unit and default) is in ``schemes/README.md``.
 """
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field
 from typing import Any, Mapping, Sequence
 
@@ -36,11 +53,13 @@ from numpy.typing import ArrayLike
 from .errors import InputError, LinkageError, SchemeError
 from .extremes import extreme_positions, table_angles, wrap_angle
 from .kinematics import Motion
-from .model import Mechanism, check_number, unknown_keys
+from .model import Mechanism, _angle, check_number, unknown_keys
 from .scheme import register_section, section_of
 
 __all__ = [
     "StrokeDiagram",
+    "Direction",
+    "diagram_value",
     "CycleTable",
     "PointForce",
     "LinkMoment",
@@ -55,10 +74,42 @@ __all__ = [
 
 STANDARD_GRAVITY = (0.0, -9.81)
 
+#: a stroke fraction within this distance of a diagram's fraction is that fraction (so a position
+#: placed at a jump of a step diagram is at the jump, whatever the round-off of its geometry)
+FRACTION_SNAP = 1e-12
+
+
+def diagram_value(t, fractions, values, before=False) -> np.ndarray:
+    """Value of a piecewise-linear diagram ``(fractions, values)`` at the fractions ``t``.
+
+    ``fractions`` increase from 0 to 1; a fraction given twice is a jump (a step diagram): the
+    first of its two values holds just before it, the second just after. At a jump the value is
+    the one just after it (the value the motion enters, as time goes on), or the one just before
+    it where ``before`` is True (per ``t``: the value the motion arrives with). Between points
+    the value is linear; ``t`` is clipped to [0, 1].
+
+    >>> diagram_value([0.25, 0.5, 0.75], [0, 0.5, 0.5, 1], [0, 10, 30, 40]).tolist()
+    [5.0, 30.0, 35.0]
+    >>> diagram_value([0.5], [0, 0.5, 0.5, 1], [0, 10, 30, 40], before=True).tolist()
+    [10.0]
+    """
+    fr = np.asarray(fractions, dtype=float)
+    va = np.asarray(values, dtype=float)
+    t = np.clip(np.asarray(t, dtype=float), 0.0, 1.0)
+    near = np.abs(t[..., None] - fr) <= FRACTION_SNAP
+    t = np.where(near.any(axis=-1), fr[np.argmax(near, axis=-1)], t)
+    before = np.broadcast_to(np.asarray(before, bool), t.shape)
+    after_index = np.searchsorted(fr, t, side="right") - 1  # fr[i] <= t < fr[i + 1]
+    before_index = np.searchsorted(fr, t, side="left") - 1  # fr[i] < t <= fr[i + 1]
+    lo = np.clip(np.where(before, before_index, after_index), 0, len(fr) - 2)
+    x0, x1 = fr[lo], fr[lo + 1]
+    w = np.clip((t - x0) / np.where(x1 > x0, x1 - x0, 1.0), 0.0, 1.0)
+    return va[lo] + w * (va[lo + 1] - va[lo])
+
 
 @dataclass(frozen=True)
 class StrokeDiagram:
-    """A force (or moment) diagram over the working stroke of an output coordinate (METHOD 7).
+    """A force (or moment) diagram over the working stroke of an output coordinate (docs/methods.md, "Loads").
 
     Parameters
     ----------
@@ -67,18 +118,24 @@ class StrokeDiagram:
     working : {1, -1}
         The working stroke is the half-cycle in which the quantity increases (+1) or decreases.
     fractions, values : sequence of float
-        Diagram points: fraction of the working stroke, 0 (start) .. 1 (end), increasing; and the
-        load's magnitude there (N or N m, >= 0). Linear in between; zero on the idle stroke unless
-        ``idle_fractions`` / ``idle_values`` are given.
+        Diagram points: fraction of the working stroke, 0 (start) .. 1 (end), nondecreasing; and
+        the load's magnitude there (N or N m, >= 0). Linear in between; a fraction given twice
+        (inside (0, 1)) is a jump, with the value just before and just after it (see
+        :func:`diagram_value`); zero on the idle stroke unless ``idle_fractions`` /
+        ``idle_values`` are given.
     opposes : bool
         True (default): the load opposes the working motion (a useful resistance); False: it
-        drives it.
+        drives it. Not used when ``signed``.
     idle_fractions, idle_values : sequence of float
         The diagram of the idle stroke (fractions of the idle stroke from its start), if any.
     stroke_ends : (float, float) or None
         ``(value_min, value_max)`` of the quantity, its extreme values: found once when a scheme
         is loaded (None: found from the mechanism's extreme positions when needed). Not part of
         the diagram's identity (equality).
+    signed : bool
+        False (default): the values are magnitudes and the load acts along the quantity, its
+        sign from ``opposes``. True: the values are signed magnitudes along a direction declared
+        with the force (a :class:`Direction`), returned as they are.
     """
 
     quantity: str
@@ -89,12 +146,16 @@ class StrokeDiagram:
     idle_fractions: tuple[float, ...] = ()
     idle_values: tuple[float, ...] = ()
     stroke_ends: tuple[float, float] | None = field(default=None, compare=False)
+    signed: bool = False
 
     def magnitude(self, mech: Mechanism, value, first, second, rotation: float, ends=None):
-        """Signed load along the quantity at positions with the given value and analogs.
+        """Signed load along the quantity at positions with the given value and analogs (along the
+        declared direction when ``signed``).
 
         At a stroke end the load is two-valued: a position counts in the stroke the mechanism
         enters (the sign of ``q''``, whatever the rotation), or in the one it leaves where ``ends`` is True.
+        At a jump of a step diagram likewise: the value just after the jump, or just before it
+        where ``ends`` is True.
         """
         if self.stroke_ends is not None:
             value_min, value_max = self.stroke_ends
@@ -114,12 +175,14 @@ class StrokeDiagram:
         if self.quantity.endswith(".theta"):  # a link angle may cross the +-pi cut
             travel = wrap_angle(travel)
         t = np.clip(np.abs(travel) / stroke, 0.0, 1.0)
-        work_mag = np.interp(t, self.fractions, self.values)
+        work_mag = diagram_value(t, self.fractions, self.values, leaving)
         if self.idle_fractions:
-            idle_mag = np.interp(1.0 - t, self.idle_fractions, self.idle_values)
+            idle_mag = diagram_value(1.0 - t, self.idle_fractions, self.idle_values, leaving)
         else:
             idle_mag = np.zeros_like(t)
         mag = np.where(working, work_mag, idle_mag)
+        if self.signed:
+            return mag
         sign = -self.working if self.opposes else self.working
         # on the idle stroke the motion is reversed: an opposing load still opposes the motion
         return np.where(working, sign * mag, -sign * mag)
@@ -127,13 +190,17 @@ class StrokeDiagram:
 
 @dataclass(frozen=True)
 class CycleTable:
-    """Load values at the positions 1..n+1 of the machine's cycle table (METHOD section 1).
+    """Load values at the positions 1..n+1 of the machine's cycle table (docs/conventions.md, "Table positions").
 
     Position 1 is the start of the cycle (``start``: "extreme", "max", "min" or degrees) and
     positions follow the rotation; between positions the value is linear in the cycle angle, and
     position n+1 (the cycle's end, same angle as position 1) may carry its own value.
     ``phi0`` is the input angle of position 1 (rad): found once when a scheme is loaded (None:
     found from ``start`` when needed); not part of the table's identity (equality).
+
+    Over an input range ``span = (a, b)`` (rad; a mechanism whose input does not turn fully) the
+    positions 1..n+1 run from a to b instead, and the value is linear in the input angle between
+    them (``start`` and ``rotation`` are not used).
     """
 
     quantity: str
@@ -141,9 +208,14 @@ class CycleTable:
     start: Any = "extreme"
     rotation: int = 1
     phi0: float | None = field(default=None, compare=False)
+    span: tuple[float, float] | None = None
 
     def magnitude(self, mech: Mechanism, phi: np.ndarray, ends=None) -> np.ndarray:
         n = len(self.values) - 1
+        if self.span is not None:
+            a, b = self.span
+            u = np.clip((np.asarray(phi, dtype=float) - a) / (b - a), 0.0, 1.0)
+            return np.interp(u, np.linspace(0.0, 1.0, n + 1), self.values)
         phi0 = self.phi0 if self.phi0 is not None else table_angles(mech, 1, self.start, self.rotation)[0]
         psi = np.mod(self.rotation * (phi - phi0), 2 * np.pi)
         psi = np.where(np.isclose(psi, 2 * np.pi, rtol=0, atol=1e-9), 0.0, psi)
@@ -153,12 +225,50 @@ class CycleTable:
 
 
 @dataclass(frozen=True)
+class Direction:
+    """The line of action of a directed force: through two named points, or fixed in a link.
+
+    Exactly one of:
+
+    - ``between = (P, Q)``: along the line through the points P and Q (of any links, the frame
+      included); a positive magnitude pushes from P towards Q, i.e. acts along ``(Q - P) / |Q - P|``;
+    - ``link = L`` with ``angle`` (rad, default 0): along the direction at ``angle``
+      counter-clockwise from link L's local x axis (it turns with the link; the frame's is fixed).
+    """
+
+    between: tuple[str, str] | None = None
+    link: str | None = None
+    angle: float = 0.0
+
+    def unit(self, motion: Motion) -> np.ndarray:
+        """Global unit vectors ``(N, 2)`` of the direction at the positions of ``motion``."""
+        if self.between is not None:
+            d = motion.point(self.between[1]) - motion.point(self.between[0])
+            length = np.hypot(d[:, 0], d[:, 1])
+            with np.errstate(divide="ignore", invalid="ignore"):
+                return np.where(length[:, None] > 0, d / length[:, None], np.nan)
+        theta = motion.poses[self.link][:, 2] + self.angle
+        return np.stack([np.cos(theta), np.sin(theta)], axis=1)
+
+    def describe(self) -> str:
+        if self.between is not None:
+            return f"between {list(self.between)}"
+        return f"along link '{self.link}' at {np.degrees(self.angle):.10g} deg"
+
+
+@dataclass(frozen=True)
 class PointForce:
-    """A force at a named point of a link: a constant vector, per-position vectors, or a diagram."""
+    """A force at a named point of a link: a constant vector, per-position vectors, or a diagram.
+
+    With a ``direction`` (:class:`Direction`) ``force`` is a signed magnitude along it (N): a
+    constant, per-position values ``(N,)``, a signed :class:`StrokeDiagram` or a
+    :class:`CycleTable`.
+    """
 
     point: str
     link: str
-    force: Any  # (2,), (N, 2), StrokeDiagram or CycleTable
+    force: Any  # (2,), (N, 2), StrokeDiagram or CycleTable; with a direction: float, (N,), ...
+    direction: Direction | None = None
 
 
 @dataclass(frozen=True)
@@ -225,13 +335,49 @@ def _numbers(raw: Any, where: str, what: str, problems: list[str], kind: str, un
     return tuple(values)
 
 
-def _diagram(mech: Mechanism, raw: Any, quantity: str, where: str, problems: list[str]):
+def _fraction_problem(fr: tuple[float, ...], key: str, raw: Any) -> str | None:
+    """Why the fractions ``fr`` of a diagram cannot be meant (None when they can): they must
+    start at 0, end at 1 and never decrease; a fraction given twice inside (0, 1) is a jump."""
+    if fr[0] != 0 or fr[-1] != 1 or any(b < a for a, b in zip(fr, fr[1:])):
+        return (f"diagram '{key}' must increase from 0 to 1 (fractions of the stroke; a fraction given "
+                f"twice is a jump), got {raw!r}")
+    for a, b, c in zip(fr, fr[1:], fr[2:]):
+        if a == b == c:
+            return (f"diagram '{key}' gives the fraction {a:g} three times, got {raw!r}: a jump has two "
+                    "values, the one just before and the one just after it")
+    for end in (0.0, 1.0):
+        if fr.count(end) > 1:
+            return (f"diagram '{key}' repeats the stroke end {end:g}, got {raw!r}: a jump must lie inside "
+                    "the stroke (0 < t < 1); at the stroke ends the load is already two-valued (the end of "
+                    "one stroke and the start of the other)")
+    return None
+
+
+def _diagram(mech: Mechanism, raw: Any, quantity: str | None, where: str, problems: list[str],
+             signed: bool = False):
+    """A :class:`StrokeDiagram` over the stroke of ``quantity``; ``signed`` (a directed force):
+    the quantity is the diagram's own ``quantity`` key and the values are signed magnitudes."""
     if not isinstance(raw, Mapping):
         problems.append(f"{where}: diagram must be a table, got {raw!r}")
         return None
-    known = {"along", "working", "fractions", "values", "opposes", "idle_fractions", "idle_values"}
+    known = {"working", "fractions", "values", "idle_fractions", "idle_values"}
+    known |= {"quantity"} if signed else {"along", "opposes"}
     if unknown_keys(raw, known, f"{where} diagram", problems):
         return None
+    if signed:
+        quantity = raw.get("quantity")
+        if not isinstance(quantity, str):
+            problems.append(f"{where}: the diagram of a directed force needs quantity = \"P.x\", \"P.y\", "
+                            f"\"L.theta\" or \"K.s\": the coordinate whose working stroke its fractions "
+                            f"measure, got {quantity!r}")
+            return None
+        from .kinematics import parse_quantity
+
+        try:
+            parse_quantity(mech, quantity)
+        except (LinkageError, ValueError, KeyError) as exc:
+            problems.append(f"{where}: diagram quantity {quantity!r}: {exc}")
+            return None
     raw_working = raw.get("working")
     working = {"+": 1, "-": -1, 1: 1, -1: -1}.get(raw_working) \
         if isinstance(raw_working, (str, int)) and not isinstance(raw_working, bool) else None
@@ -247,13 +393,17 @@ def _diagram(mech: Mechanism, raw: Any, quantity: str, where: str, problems: lis
         fr = _numbers(raw.get(fk), where, f"diagram '{fk}'", problems, "fraction", at_least=2)
         if fr is None:
             return None
-        vals = _numbers(raw.get(vk), where, f"diagram '{vk}' (magnitudes: the sign comes from "
-                        "'opposes')", problems, "nonnegative", length=len(fr))
+        if signed:
+            vals = _numbers(raw.get(vk), where, f"diagram '{vk}' (signed magnitudes along the force's "
+                            "direction, N)", problems, "real", "N", length=len(fr))
+        else:
+            vals = _numbers(raw.get(vk), where, f"diagram '{vk}' (magnitudes: the sign comes from "
+                            "'opposes')", problems, "nonnegative", length=len(fr))
         if vals is None:
             return None
-        if fr[0] != 0 or fr[-1] != 1 or any(b <= a for a, b in zip(fr, fr[1:])):
-            problems.append(f"{where}: diagram '{fk}' must increase from 0 to 1 (fractions of the "
-                            f"stroke), got {raw.get(fk)!r}")
+        problem = _fraction_problem(fr, fk, raw.get(fk))
+        if problem:
+            problems.append(f"{where}: {problem}")
             return None
         curves.append((fr, vals))
     opposes = raw.get("opposes", True)
@@ -270,24 +420,36 @@ def _diagram(mech: Mechanism, raw: Any, quantity: str, where: str, problems: lis
                         f"{quantity} does not move (stroke {ext.stroke:.3g})")
         return None
     return StrokeDiagram(quantity, working, *curves[0], opposes, *curves[1],
-                         stroke_ends=(ext.value_min, ext.value_max))
+                         stroke_ends=(ext.value_min, ext.value_max), signed=signed)
 
 
-def _cycle_table(mech: Mechanism, spec, point: str, where: str, problems: list[str]):
-    """A :class:`CycleTable` from ``cycle = [...]`` and ``along``; the cycle (start, rotation) is
-    the one the mechanism's ``[dynamics]`` declares."""
-    along = spec.get("along")
-    if along not in ("x", "y"):
-        problems.append(f"{where}: a cycle table needs along = \"x\" or \"y\", got {along!r}")
-        return None
+#: table positions of a cycle table when the scheme's [dynamics] declares no ``positions``
+DEFAULT_POSITIONS = 12
+
+
+def _cycle_table(mech: Mechanism, spec, quantity: str, where: str, problems: list[str]):
+    """A :class:`CycleTable` from ``cycle = [...]``: one value per position 1..n+1 of the cycle's
+    table (n: the ``positions`` of ``[dynamics]``, default 12). The cycle (start, rotation) is
+    the one the mechanism's ``[dynamics]`` declares; over an input range, positions 1..n+1 run
+    over the range and ``[dynamics]`` is not needed."""
     values = _numbers(spec.get("cycle"), where, "cycle (the values, N, at positions 1..n+1)", problems,
-                      "real", "N", at_least=3)
+                      "real", "N", at_least=2)
     if values is None:
         return None
     try:
         dyn = section_of(mech, "dynamics")
     except SchemeError:  # the [dynamics] section's own problems are reported with it
         return None
+    n = dyn.positions if dyn is not None else DEFAULT_POSITIONS
+    if len(values) != n + 1:
+        declared = (f"[dynamics] positions = {n}" if dyn is not None and "positions" in (mech.extra.get("dynamics")
+                                                                                         or {})
+                    else f"{n} positions by default; declare [dynamics] positions = N for another table")
+        problems.append(f"{where}: cycle has {len(values)} values, expected {n + 1}: one per position 1..{n + 1} "
+                        f"of the cycle's table ({declared}), the last one closing the cycle")
+        return None
+    if mech.input_range is not None:
+        return CycleTable(quantity, values, span=tuple(mech.input_range))
     if dyn is None:
         problems.append(f"{where}: a cycle table needs the direction of rotation: declare [dynamics] "
                         "mean_speed (rad/s) or mean_rpm, signed")
@@ -297,7 +459,7 @@ def _cycle_table(mech: Mechanism, spec, point: str, where: str, problems: list[s
     except (LinkageError, ValueError) as exc:
         problems.append(f"{where}: the cycle's first position: {exc}")
         return None
-    return CycleTable(f"{point}.{along}", values, dyn.start, dyn.rotation, phi0)
+    return CycleTable(quantity, values, dyn.start, dyn.rotation, phi0)
 
 
 def _entries(raw: Mapping[str, Any], key: str, problems: list[str]) -> list:
@@ -307,6 +469,137 @@ def _entries(raw: Mapping[str, Any], key: str, problems: list[str]) -> list:
         problems.append(f"{key}: expected an array of tables ([[loads.{key}]]), got {entries!r}")
         return []
     return entries
+
+
+#: keys of a ``[[loads.forces]]`` entry
+FORCE_KEYS = {"point", "link", "force", "diagram", "cycle", "along", "magnitude", "between", "along_link",
+              "angle", "angle_deg"}
+#: input angles at which the two points of a ``between`` direction are checked not to coincide
+DIRECTION_SWEEP = 360
+
+
+def _direction(mech: Mechanism, spec: Mapping[str, Any], where: str, problems: list[str]):
+    """The :class:`Direction` a force entry declares (``between`` or ``along_link``), None when it
+    declares none, or ``False`` (with the problem) when it is declared wrongly."""
+    given = [k for k in ("between", "along_link") if k in spec]
+    has_angle = "angle" in spec or "angle_deg" in spec
+    if not given:
+        if has_angle:
+            key = "angle_deg" if "angle_deg" in spec else "angle"
+            problems.append(f"{where}: {key} = {spec[key]!r} gives the direction of a force in the frame of the "
+                            "link named by along_link = \"...\"; declare along_link (or give force = [Fx, Fy])")
+            return False
+        return None
+    if len(given) == 2:
+        problems.append(f"{where}: give one direction, between = [\"P\", \"Q\"] or along_link = \"L\", not both")
+        return False
+    if "between" in spec:
+        pts = spec["between"]
+        if has_angle:
+            key = "angle_deg" if "angle_deg" in spec else "angle"
+            problems.append(f"{where}: {key} = {spec[key]!r} goes with along_link, not with between = {pts!r}")
+            return False
+        if not (isinstance(pts, list) and len(pts) == 2 and all(isinstance(q, str) for q in pts)):
+            problems.append(f"{where}: between must name two points [\"P\", \"Q\"] (a positive magnitude "
+                            f"pushes from P towards Q), got {pts!r}")
+            return False
+        unknown = [q for q in pts if not mech.point_links(q)]
+        if unknown:
+            problems.append(f"{where}: between {pts!r}: unknown point {unknown[0]!r} (points: {mech.point_names})")
+            return False
+        if pts[0] == pts[1]:
+            problems.append(f"{where}: between {pts!r} names one point twice: a line needs two points")
+            return False
+        direction = Direction(between=(pts[0], pts[1]))
+        problem = _coincide(mech, direction)
+        if problem:
+            problems.append(f"{where}: between {pts!r}: {problem}")
+            return False
+        return direction
+    link = spec["along_link"]
+    if not (isinstance(link, str) and link in mech.links):
+        problems.append(f"{where}: along_link must name a link (the direction is fixed in its frame), got "
+                        f"{link!r} (links: {sorted(mech.links)})")
+        return False
+    count = len(problems)
+    angle = _angle(spec, "angle", where, problems)
+    if len(problems) > count:
+        return False
+    return Direction(link=link, angle=angle)
+
+
+def _coincide(mech: Mechanism, direction: Direction) -> str | None:
+    """Why the line through the two points of ``direction`` is undefined (they coincide at some
+    input angle of the turn or range), or None."""
+    from .kinematics import analyze
+
+    lo, hi = mech.input_range if mech.input_range is not None else (0.0, 2 * np.pi)
+    phi = np.linspace(lo, hi, DIRECTION_SWEEP + 1)
+    with warnings.catch_warnings():  # mode changes are the analysis's to report, not the load's
+        warnings.simplefilter("ignore")
+        motion = analyze(mech, phi, order=0, on_failure="mask")
+    p, q = (motion.point(name) for name in direction.between)
+    gap = np.hypot(*(q - p).T)
+    close = np.flatnonzero(np.isfinite(gap) & (gap <= 1e-9 * mech.size))
+    if len(close):
+        shown = ", ".join(f"{np.degrees(phi[i]):.4g}" for i in close[:5])
+        return (f"the two points coincide at phi = {shown} deg: the direction of the force is undefined "
+                "there; choose two points that stay apart")
+    return None
+
+
+def _point_force(mech: Mechanism, spec: Mapping[str, Any], point: str, link: str, where: str,
+                 problems: list[str]):
+    """The :class:`PointForce` of one ``[[loads.forces]]`` entry (None with the problem)."""
+    direction = _direction(mech, spec, where, problems)
+    if direction is False:
+        return None
+    if direction is None:
+        if "magnitude" in spec:
+            problems.append(f"{where}: magnitude = {spec['magnitude']!r} is a signed value along a direction: "
+                            "declare the direction with "
+                            "between = [\"P\", \"Q\"] or along_link = \"L\" (or give force = [Fx, Fy])")
+            return None
+        if sum(k in spec for k in ("force", "diagram", "cycle")) != 1:
+            problems.append(f"{where}: give exactly one of 'force' = [Fx, Fy], 'diagram' = {{...}} or "
+                            "'cycle' = [values at the cycle's positions]")
+            return None
+        if "cycle" in spec:
+            along = spec.get("along")
+            if along not in ("x", "y"):
+                problems.append(f"{where}: a cycle table needs along = \"x\" or \"y\", got {along!r}")
+                return None
+            table = _cycle_table(mech, spec, f"{point}.{along}", where, problems)
+            return None if table is None else PointForce(point, link, table)
+        if "force" in spec:
+            vec = _numbers(spec["force"], where, "force [Fx, Fy]", problems, "real", "N", length=2)
+            return None if vec is None else PointForce(point, link, vec)
+        along = spec["diagram"].get("along") if isinstance(spec["diagram"], Mapping) else None
+        if along not in ("x", "y"):
+            problems.append(f"{where}: diagram 'along' must be \"x\" or \"y\", got {along!r}")
+            return None
+        d = _diagram(mech, spec["diagram"], f"{point}.{along}", where, problems)
+        return None if d is None else PointForce(point, link, d)
+    told = f"{where} ({direction.describe()})"
+    for key, why in (("force", "is a vector [Fx, Fy]; along a declared direction give magnitude = F (N, "
+                               "signed)"),
+                     ("along", "is the axis of an x / y cycle table or diagram; a directed force acts along "
+                               "its declared direction")):
+        if key in spec:
+            problems.append(f"{told}: {key} = {spec[key]!r} {why}")
+            return None
+    if sum(k in spec for k in ("magnitude", "diagram", "cycle")) != 1:
+        problems.append(f"{told}: give exactly one of 'magnitude' = F (N, signed), 'diagram' = {{quantity, "
+                        "working, fractions, values} or 'cycle' = [values at the cycle's positions]")
+        return None
+    if "magnitude" in spec:
+        value = check_number(spec["magnitude"], told, "magnitude", problems, "real", "N")
+        return None if value is None else PointForce(point, link, value, direction)
+    if "cycle" in spec:
+        table = _cycle_table(mech, spec, f"{point}.force", told, problems)
+        return None if table is None else PointForce(point, link, table, direction)
+    d = _diagram(mech, spec["diagram"], None, told, problems, signed=True)
+    return None if d is None else PointForce(point, link, d, direction)
 
 
 def parse_loads(mech: Mechanism, raw: Mapping[str, Any] | None) -> tuple[Loads, list[str]]:
@@ -330,7 +623,7 @@ def parse_loads(mech: Mechanism, raw: Mapping[str, Any] | None) -> tuple[Loads, 
         if not isinstance(spec, Mapping):
             problems.append(f"{where}: expected a table, got {spec!r}")
             continue
-        if unknown_keys(spec, {"point", "link", "force", "diagram", "cycle", "along"}, where, problems):
+        if unknown_keys(spec, FORCE_KEYS, where, problems):
             continue
         point = spec.get("point")
         where = f"forces[{i}] (point {point!r})"
@@ -349,26 +642,9 @@ def parse_loads(mech: Mechanism, raw: Mapping[str, Any] | None) -> tuple[Loads, 
         elif link not in owners:
             problems.append(f"{where}: link {link!r} has no point {point!r} (links with it: {owners})")
             continue
-        if sum(k in spec for k in ("force", "diagram", "cycle")) != 1:
-            problems.append(f"{where}: give exactly one of 'force' = [Fx, Fy], 'diagram' = {{...}} or "
-                            "'cycle' = [values at the cycle's positions]")
-            continue
-        if "cycle" in spec:
-            table = _cycle_table(mech, spec, f"{point}", where, problems)
-            if table is not None:
-                forces.append(PointForce(point, link, table))
-        elif "force" in spec:
-            vec = _numbers(spec["force"], where, "force [Fx, Fy]", problems, "real", "N", length=2)
-            if vec is not None:
-                forces.append(PointForce(point, link, vec))
-        else:
-            along = spec["diagram"].get("along") if isinstance(spec["diagram"], Mapping) else None
-            if along not in ("x", "y"):
-                problems.append(f"{where}: diagram 'along' must be \"x\" or \"y\", got {along!r}")
-                continue
-            d = _diagram(mech, spec["diagram"], f"{point}.{along}", where, problems)
-            if d is not None:
-                forces.append(PointForce(point, link, d))
+        force = _point_force(mech, spec, point, link, where, problems)
+        if force is not None:
+            forces.append(force)
     for i, spec in enumerate(_entries(raw, "moments", problems)):
         where = f"moments[{i}]"
         if not isinstance(spec, Mapping):
@@ -431,7 +707,7 @@ def evaluate_loads(motion: Motion, loads: Loads, ends: ArrayLike | None = None) 
     """Gravity and external loads at the positions of ``motion`` (inertia not included).
 
     ``ends`` (bool, per position) marks positions that end a cycle: at a stroke end they take the
-    value of the stroke that ends there (METHOD section 7).
+    value of the stroke that ends there (docs/methods.md, "Loads").
     """
     mech, n = motion.mechanism, len(motion.phi)
     rotation = 1.0 if motion.omega is None else float(np.sign(np.mean(motion.omega)) or 1.0)
@@ -447,7 +723,16 @@ def evaluate_loads(motion: Motion, loads: Loads, ends: ArrayLike | None = None) 
     for f in loads.forces:
         local = mech.links[f.link].points[f.point]
         kind = "external"
-        if isinstance(f.force, (StrokeDiagram, CycleTable)):
+        if f.direction is not None:  # a signed magnitude along a direction of the motion
+            if isinstance(f.force, StrokeDiagram):
+                value, d1, d2 = motion.quantity(f.force.quantity)
+                mag = f.force.magnitude(mech, value, d1, d2, rotation, ends)
+            elif isinstance(f.force, CycleTable):
+                mag = f.force.magnitude(mech, motion.phi, ends)
+            else:
+                mag = _per_position(f.force, n, (), f"magnitude of the force at point '{f.point}'")
+            vec = mag[:, None] * f.direction.unit(motion)
+        elif isinstance(f.force, (StrokeDiagram, CycleTable)):
             if isinstance(f.force, StrokeDiagram):
                 value, d1, d2 = motion.quantity(f.force.quantity)
                 mag = f.force.magnitude(mech, value, d1, d2, rotation, ends)
@@ -472,7 +757,7 @@ def evaluate_loads(motion: Motion, loads: Loads, ends: ArrayLike | None = None) 
 
 
 def inertia_terms(motion: Motion) -> list[LoadTerm]:
-    """Inertia forces ``-m a_S`` at the centres of mass and moments ``-J_S eps_k`` (METHOD 5).
+    """Inertia forces ``-m a_S`` at the centres of mass and moments ``-J_S eps_k`` (docs/methods.md, "Kinetostatics").
 
     Needs a motion analysed with ``omega`` (and ``eps``) and second analogs.
     """

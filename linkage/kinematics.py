@@ -8,7 +8,7 @@
 
 Results are exact: positions by each group's closed form, first and second transfer functions
 (analogs, derivatives with respect to the input angle phi) from the group constraint Jacobians
-(METHOD section 3); real velocities and accelerations follow as ``q' omega`` and
+(docs/methods.md#analogs); real velocities and accelerations follow as ``q' omega`` and
 ``q'' omega^2 + q' eps``.
 """
 
@@ -28,7 +28,8 @@ from .errors import AssemblyError, InputError, StructureError
 from .model import Mechanism, Prismatic
 from .structure import Structure, decompose
 
-__all__ = ["Motion", "analyze", "structure_of", "assembly_branches", "BranchWarning", "parse_quantity"]
+__all__ = ["Motion", "analyze", "structure_of", "assembly_branches", "BranchWarning", "parse_quantity",
+           "table_positions_deg", "angle_in_half_turn"]
 
 
 class BranchWarning(UserWarning):
@@ -162,11 +163,29 @@ class Motion:
             raise InputError("real velocities need omega (analyze(..., omega=..., eps=...))")
 
     # -- table ---------------------------------------------------------------------------------
-    def columns(self) -> dict[str, np.ndarray]:
-        """The standard table: ``phi_deg``; per point ``P.x P.y P.x' P.y' P.x'' P.y''``; per moving
-        link ``L.theta L.theta' L.theta''``; per prismatic pair ``K.s K.s' K.s''`` (SI units)."""
+    def columns(self, direction: int | None = None) -> dict[str, np.ndarray]:
+        """The standard table (the one ``linkage analyze`` prints), in the table conventions of
+        :func:`table_positions_deg` and :func:`angle_in_half_turn`.
+
+        Columns: ``i`` (position number from 1), ``phi_deg`` (the input angle travelled from the
+        first row along the table, deg: 0, 30, ... 360 for a turn in 12 steps, in either sense of
+        rotation); per point ``P.x P.y P.x' P.y' P.x'' P.y''``; per moving link
+        ``L.theta L.theta' L.theta''`` (``L.theta`` the link's absolute angle, CCW from +x, rad, in
+        (-pi, pi]; for the input link it is the absolute input angle phi); per prismatic pair
+        ``K.s K.s' K.s''``. SI units: m, rad; ``'`` and ``''`` are d/dphi and d2/dphi2.
+
+        Parameters
+        ----------
+        direction : {1, -1}, optional
+            The sense that ``phi_deg`` counts in. Default: the sense of the analysed angles (of
+            their first step); for a single angle the sign of a nonzero ``omega``, else +1.
+        """
         mech = self.mechanism
-        cols: dict[str, np.ndarray] = {"phi_deg": np.degrees(self.phi)}
+        direction = self._direction() if direction is None else direction
+        if direction not in (1, -1):
+            raise InputError(f"direction must be +1 or -1, got {direction!r}")
+        cols: dict[str, np.ndarray] = {"i": np.arange(1, len(self.phi) + 1),
+                                       "phi_deg": table_positions_deg(self.phi, direction)}
         primes = ("", "'", "''")
         for p in mech.point_names:
             if mech.point_link(p) in self.poses:
@@ -181,8 +200,53 @@ class Motion:
         for q in quantities:
             for prime, arr in zip(primes, self.quantity(q)):
                 if arr is not None:
-                    cols[q + prime] = arr
+                    cols[q + prime] = angle_in_half_turn(arr) if q.endswith(".theta") and not prime else arr
         return cols
+
+    def _direction(self) -> int:
+        """The sense of the table: of the first step between the angles; for a single angle the
+        sign of a nonzero omega; else +1."""
+        sense = _sense(self.phi)
+        if sense is None and self.omega is not None:
+            moving = self.omega[np.isfinite(self.omega) & (self.omega != 0)]
+            sense = (1 if moving[0] > 0 else -1) if len(moving) else None
+        return 1 if sense is None else sense
+
+
+def _sense(phi: np.ndarray) -> int | None:
+    """+1 / -1: the sign of the first nonzero step of ``phi``; None when there is none."""
+    steps = np.diff(phi)
+    steps = steps[steps != 0]
+    return (1 if steps[0] > 0 else -1) if len(steps) else None
+
+
+def table_positions_deg(phi: ArrayLike, direction: int | None = None) -> np.ndarray:
+    """The ``phi_deg`` column of every table: the input angle travelled from the first row along
+    the table, deg: ``direction (phi - phi[0])`` with ``direction`` (default) the sense of the
+    table's first step. Over a turn it runs 0 .. 360 whatever the sense of rotation; over an
+    input range [a, b], 0 .. |b - a|. Rounded to 1e-10 deg, so that table steps read 30, not
+    29.999999999999996 (far below the rounding of the angles themselves, ~1e-13 deg).
+
+    >>> table_positions_deg(np.radians([10.0, -20.0, -50.0])).tolist()
+    [0.0, 30.0, 60.0]
+    """
+    phi = np.atleast_1d(np.asarray(phi, dtype=float))
+    if not len(phi):
+        return phi.copy()
+    if direction is None:
+        direction = _sense(phi) or 1
+    return np.round(np.degrees(direction * (phi - phi[0])), 10) + 0.0
+
+
+def angle_in_half_turn(angle: ArrayLike) -> np.ndarray:
+    """Angles (rad) folded into (-pi, pi], the range of every direction angle in tables (link
+    angles ``L.theta``; reaction directions in degrees use the same range, (-180, 180]).
+
+    >>> angle_in_half_turn(np.array([np.pi, -np.pi, 3 * np.pi / 2, 0.0])).round(6).tolist()
+    [3.141593, 3.141593, -1.570796, 0.0]
+    """
+    angle = np.asarray(angle, dtype=float)
+    return np.pi - np.mod(np.pi - angle, 2 * np.pi)
 
 
 def parse_quantity(mech: Mechanism, name: str) -> tuple[str, str, int]:
@@ -223,7 +287,7 @@ def analyze(
     mech : Mechanism
         The mechanism (one input link).
     phi : array_like, shape (N,) or scalar
-        Input angles, rad (CCW from +x, METHOD section 1).
+        Input angles, rad (CCW from +x, docs/conventions.md).
     order : {0, 1, 2}
         Highest analog order to compute (0: positions only).
     outputs : iterable of str, optional

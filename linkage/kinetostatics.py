@@ -1,4 +1,4 @@
-"""Kinetostatic force analysis: pair reactions and the balancing moment (METHOD section 5).
+"""Kinetostatic force analysis: pair reactions and the balancing moment (docs/methods.md#kinetostatics).
 
 The groups are solved in reverse order of the structure ("from the farthest group") through the
 shared group protocol (the transposed constraint Jacobian, :meth:`assur.base.Group.reactions`);
@@ -30,7 +30,7 @@ from assur.base import OK, PrismaticJoint, point_analogs
 
 from .errors import InputError
 from .forces import LoadTerm, Loads, evaluate_loads, generalized_loads, inertia_terms, loads_of
-from .kinematics import Motion
+from .kinematics import Motion, angle_in_half_turn, table_positions_deg
 
 __all__ = ["Reactions", "solve_reactions", "virtual_power_residual"]
 
@@ -88,14 +88,20 @@ class Reactions:
         return np.hypot(*self.force(pair).T)
 
     def direction_deg(self, pair: str) -> np.ndarray:
-        """Direction angle of ``R[a, b]``, deg CCW from +x."""
+        """Direction angle of ``R[a, b]``, deg CCW from +x, in (-180, 180]."""
         f = self.force(pair)
-        return np.degrees(np.arctan2(f[:, 1], f[:, 0]))
+        return np.degrees(angle_in_half_turn(np.arctan2(f[:, 1], f[:, 0])))
 
-    def columns(self, full: bool = False) -> dict[str, np.ndarray]:
-        """Table: ``phi_deg``, ``balancing_moment``, per pair ``K.R`` (magnitude, N) and
-        ``K.angle_deg``; with ``full`` also ``K.Rx``, ``K.Ry`` and, for prismatic pairs, ``K.M``."""
-        cols = {"phi_deg": np.degrees(self.motion.phi), "balancing_moment": self.balancing_moment}
+    def columns(self, full: bool = False, direction: int | None = None) -> dict[str, np.ndarray]:
+        """Table: ``i``, ``phi_deg`` (as in :meth:`Motion.columns`), ``balancing_moment`` (N m),
+        per pair ``K.R`` (magnitude of ``R[a, b]``, N) and ``K.angle_deg`` (its direction, deg CCW
+        from +x in (-180, 180]); with ``full`` also ``K.Rx``, ``K.Ry`` (N) and, for
+        prismatic pairs, ``K.M`` (N m, the moment of the slider on the guide about the slider's
+        point). Pairs in the order of their names. ``direction``: see :meth:`Motion.columns`."""
+        direction = self.motion._direction() if direction is None else direction
+        cols = {"i": np.arange(1, len(self.motion.phi) + 1),
+                "phi_deg": table_positions_deg(self.motion.phi, direction),
+                "balancing_moment": self.balancing_moment}
         for name in sorted(self.multipliers):
             cols[f"{name}.R"] = self.magnitude(name)
             cols[f"{name}.angle_deg"] = self.direction_deg(name)

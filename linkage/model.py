@@ -1,8 +1,9 @@
 """The mechanism model: links, kinematic pairs and the graph they form.
 
 A :class:`Mechanism` is a graph whose nodes are links (the frame among them) and whose edges are
-kinematic pairs. Geometry lives in each link's own frame (METHOD section 3): a link's pose is the
-global position of its local origin and the angle of its local x axis.
+kinematic pairs. Geometry lives in each link's own frame (docs/methods.md, "Poses and pair
+equations"): a link's pose is the global position of its local origin and the angle of its local
+x axis.
 
 Build one with :class:`MechanismBuilder` (the scheme loader uses the same builder), e.g.
 
@@ -130,7 +131,7 @@ class Prismatic:
     point : str
         The slider's point that stays on the guide line.
     angle : float
-        Fixed angle of the slider's x axis relative to the guide direction, rad (beta in METHOD).
+        Fixed angle of the slider's x axis relative to the guide direction, rad (beta in docs/methods.md).
     """
 
     name: str
@@ -189,6 +190,11 @@ class Mechanism:
     """A planar mechanism with lower pairs.
 
     Use :class:`MechanismBuilder` or :func:`linkage.load` to make one: they validate it.
+
+    ``input_range`` ``(a, b)`` (rad), when given, is the range of the input angle over which the
+    mechanism is analysed (a mechanism whose input does not turn fully: a rocker input, a
+    tangent mechanism): tables run from ``a`` to ``b``, extreme positions are searched within
+    it, and computations over a full turn (cycle dynamics) refuse it. None: a full turn.
     """
 
     name: str
@@ -200,6 +206,7 @@ class Mechanism:
     output: Output | None = None
     description: str = ""
     extra: Mapping[str, Any] = field(default_factory=dict, compare=True)
+    input_range: tuple[float, float] | None = None
 
     @cached_property
     def parts(self) -> dict[str, Any]:
@@ -261,7 +268,7 @@ class Mechanism:
         merged.update(extra)
         return Mechanism(
             self.name, self.links, self.pairs, self.inputs, self.frame, self.assembly,
-            self.output, self.description, merged,
+            self.output, self.description, merged, self.input_range,
         )
 
 
@@ -417,6 +424,7 @@ class MechanismBuilder:
         self._inputs: list[str] = []
         self._assembly: list[Assembly] = []
         self._output: Output | None = None
+        self._range: tuple[float, float] | None = None
         self._problems: list[str] = []
         self._rejected: set[str] = set()  # links and pairs refused (reported already)
         self._unplaced: dict[str, set[str]] = {}  # link -> its points and guides refused
@@ -663,6 +671,28 @@ class MechanismBuilder:
         self._output = Output(quantity, start)
         return self
 
+    def input_range(self, start: float, end: float) -> "MechanismBuilder":
+        """Analyse the mechanism over the input angles from ``start`` to ``end`` (rad) instead of
+        a full turn: for an input that does not turn fully (a rocker input, a tangent mechanism).
+
+        Tables run from ``start`` to ``end`` (``end < start`` for an input that turns clockwise);
+        the two must differ by more than 0 and less than a full turn.
+        """
+        where = "input range"
+        ok = [check_number(v, where, name, self._problems, "angle", "rad") for v, name in
+              ((start, "start"), (end, "end"))]
+        if None in ok:
+            return self
+        a, b = ok
+        if not 0 < abs(b - a) < 2 * math.pi:
+            self._problems.append(
+                f"{where}: the range [{math.degrees(a):.10g}, {math.degrees(b):.10g}] deg must span more than 0 "
+                f"and less than 360 deg (a full turn needs no range; choose position 1 with start_deg), "
+                f"got a span of {abs(math.degrees(b - a)):.10g} deg")
+            return self
+        self._range = (a, b)
+        return self
+
     def build(self, **extra: Any) -> Mechanism:
         """Validate and return the mechanism; raise :class:`SchemeError` listing every problem."""
         if self.frame not in self._links:
@@ -677,6 +707,7 @@ class MechanismBuilder:
             self._output,
             self.description,
             dict(extra),
+            self._range,
         )
         refused = dict(self._unplaced)
         for name in self._incomplete:

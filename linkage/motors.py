@@ -1,4 +1,4 @@
-"""Motor characteristics reduced to the input link (METHOD section 6).
+"""Motor characteristics reduced to the input link (docs/methods.md, "Motor characteristics").
 
 Each motor is a callable ``motor(w) -> M``: the driving moment at the input link (N m, positive
 when it drives) for the input's speed ``w = |omega| > 0`` (rad/s) in the direction of rotation.
@@ -21,7 +21,7 @@ import numpy as np
 
 from .errors import DynamicsInputError
 
-__all__ = ["ConstantMotor", "LinearMotor", "InductionMotor", "motor_from_spec", "RPM"]
+__all__ = ["ConstantMotor", "LinearMotor", "InductionMotor", "motor_from_spec", "starting_moment", "RPM"]
 
 RPM = 2 * math.pi / 60  # rad/s per rpm
 
@@ -123,6 +123,13 @@ class InductionMotor:
         return self.synchronous_rpm * (1 - slip) * RPM / self.ratio
 
 
+def starting_moment(motor: Any) -> float:
+    """The motor's moment at the input link at rest (``w = 0``), N m: its starting torque
+    reduced to the input (a constant motor's moment, ``U eta M_0`` of a linear motor, the Kloss
+    moment at slip 1 of an induction motor). A start from rest needs it > 0."""
+    return float(np.asarray(motor(0.0), dtype=float))
+
+
 def _fail(message: str) -> None:
 
     raise DynamicsInputError(message)
@@ -144,6 +151,15 @@ def _check(motor: Any, **rules: str) -> None:
 def motor_from_spec(spec: Mapping[str, Any]) -> tuple[Any | None, list[str]]:
     """A motor and the list of problems from a scheme's ``[dynamics.motor]`` table.
 
+    Keys (``kind`` and, per kind; every speed and moment on the motor's shaft unless said):
+
+    - ``constant``: ``moment`` (N m, at the input link, no gear);
+    - ``linear``: ``stall_moment`` M_0 (N m, at rest), ``no_load_speed`` (rad/s) or
+      ``no_load_rpm`` (rpm), ``ratio`` U = motor speed / input speed (default 1), ``efficiency``
+      (default 1);
+    - ``induction``: ``synchronous_rpm``, ``rated_rpm`` (rpm), ``rated_moment`` (N m) or
+      ``rated_power`` (W), ``overload`` M_k / M_nom (default 2), ``ratio``, ``efficiency``.
+
     Every number is checked against its range (``schemes/README.md``, "Ranges"): moments within
     1e50 in magnitude, speeds, ratios, rated power and moment in [1e-50, 1e50], efficiency in
     (0, 1], overload in (1, 1e50], rated_rpm below synchronous_rpm.
@@ -164,16 +180,24 @@ def motor_from_spec(spec: Mapping[str, Any]) -> tuple[Any | None, list[str]]:
     cls, required, optional = fields[kind]
     where = f"motor ({kind})"
     problems: list[str] = []
-    if unknown_keys({k: v for k, v in spec.items() if k != "kind"}, required | optional, where, problems):
+    # rpm twins of speeds in rad/s: no_load_rpm for no_load_speed
+    twins = {"no_load_rpm": "no_load_speed"} if kind == "linear" else {}
+    if unknown_keys({k: v for k, v in spec.items() if k != "kind"}, required | optional | set(twins), where,
+                    problems):
         return None, problems
-    given = set(spec) - {"kind"}
+    for twin, key in twins.items():
+        if twin in spec and key in spec:
+            return None, [f"{where}: give either {key} (rad/s) or {twin} (rpm), not both"]
+    given = {twins.get(k, k) for k in spec} - {"kind"}
     if required - given:
-        problems.append(f"{where}: missing {sorted(required - given)}")
+        problems.append(f"{where}: missing {sorted(required - given)}"
+                        + (" (or no_load_rpm)" if "no_load_speed" in required - given else ""))
     ranges = {"moment": ("real", "N m"), "stall_moment": ("real", "N m"), "no_load_speed": ("positive", "rad/s"),
+              "no_load_rpm": ("positive", "rpm"),
               "ratio": ("positive", ""), "synchronous_rpm": ("positive", "rpm"), "rated_rpm": ("positive", "rpm"),
               "rated_power": ("positive", "W"), "rated_moment": ("positive", "N m")}
     args = {}
-    for k in sorted(given):
+    for k in sorted(set(spec) - {"kind"}):
         v = spec[k]
         if k == "efficiency":
             if _is_real(v) and 0 < v <= 1:
@@ -189,6 +213,9 @@ def motor_from_spec(spec: Mapping[str, Any]) -> tuple[Any | None, list[str]]:
             args[k] = check_number(v, where, k, problems, *ranges[k])
     if problems:
         return None, problems
+    for twin, key in twins.items():
+        if twin in args:
+            args[key] = args.pop(twin) * RPM
     if kind == "induction":
         if ("rated_moment" in args) == ("rated_power" in args):
             return None, [f"{where}: give exactly one of rated_moment (N m) or rated_power (W)"]

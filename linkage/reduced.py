@@ -1,4 +1,4 @@
-"""Reduced characteristics at the input link (METHOD section 6).
+"""Reduced characteristics at the input link (docs/methods.md#reduced-moment-and-moment-of-inertia).
 
 With ``s = sign(omega_m)`` and ``psi = s phi`` (the angle in the direction of rotation):
 
@@ -114,7 +114,7 @@ def reduced_characteristics(
         Constant inertia reduced to the input besides the input link's own (rotors, flywheel),
         kg m^2.
     ends : array_like of bool, optional
-        Positions that end the cycle (two-valued loads at stroke ends, METHOD section 7).
+        Positions that end the cycle (two-valued loads at stroke ends, docs/methods.md#loads).
 
     Raises
     ------

@@ -15,6 +15,7 @@ import importlib.resources
 import math
 import re
 import tomllib
+import warnings
 from pathlib import Path
 from typing import Any, Callable, Mapping
 
@@ -25,7 +26,8 @@ from .model import (MAX_ANGLE_DEG, Mechanism, MechanismBuilder, Prismatic, Revol
 __all__ = ["load", "loads", "dumps", "save", "shipped_schemes", "scheme_path", "section_of",
            "register_section", "SECTION_PARSERS"]
 
-TOP_KEYS = {"name", "description", "frame", "input", "inputs", "output", "links", "pairs", "assembly"}
+TOP_KEYS = {"name", "description", "frame", "input", "inputs", "output", "links", "pairs", "assembly",
+            "range", "range_deg"}
 LINK_KEYS = {"line", "length", "points", "guides", "mass", "com", "inertia"}
 PAIR_KEYS = {"kind", "links", "at", "guide", "angle", "angle_deg"}
 #: keys of a link that place its points or guides (or its centre of mass, which its mass needs):
@@ -236,6 +238,9 @@ def from_dict(data: Mapping[str, Any], default_name: str = "mechanism") -> Mecha
             builder.output(output["quantity"], output.get("start", "max"))
         else:
             problems.append(f"output: expected \"P.x\" or {{quantity, start}}, got {output!r}")
+    span = _input_range(data, problems)
+    if span is not None:
+        builder.input_range(*span)
     try:
         mech = builder.build(**extra_sections)
     except SchemeError as exc:
@@ -249,6 +254,8 @@ def from_dict(data: Mapping[str, Any], default_name: str = "mechanism") -> Mecha
         raise
     except LinkageError as exc:  # a wrong mobility, a group that never assembles ...
         raise SchemeError(str(exc)) from None
+    if mech.input_range is not None:
+        _check_range_assembles(mech, data)
     for section in _section_order():
         if section not in mech.parts:
             value, found = SECTION_PARSERS[section](mech, extra_sections.get(section))
@@ -258,6 +265,73 @@ def from_dict(data: Mapping[str, Any], default_name: str = "mechanism") -> Mecha
     if problems:
         raise SchemeError(problems)
     return mech
+
+
+#: input angles at which a declared input range is checked to assemble (ends included)
+RANGE_SWEEP = 361
+
+
+def _input_range(data: Mapping[str, Any], problems: list[str]) -> tuple[float, float] | None:
+    """The input range ``range_deg = [a, b]`` (or ``range``, rad) in rad; None when absent or
+    refused (with the problem, naming the key and the value)."""
+    if "range" in data and "range_deg" in data:
+        problems.append("give either 'range' (rad) or 'range_deg' (deg), not both")
+        return None
+    key = "range_deg" if "range_deg" in data else "range" if "range" in data else None
+    if key is None:
+        return None
+    raw = data[key]
+    unit, largest = ("deg", MAX_ANGLE_DEG) if key == "range_deg" else ("rad", math.radians(MAX_ANGLE_DEG))
+    if not (isinstance(raw, list) and len(raw) == 2 and all(_is_number(v) and abs(v) <= largest for v in raw)):
+        problems.append(f"{key}: expected [a, b], two input angles in {unit} with |x| <= {largest:.6g} "
+                        f"(the input turns from a to b), got {raw!r}")
+        return None
+    a, b = (math.radians(v) for v in raw) if key == "range_deg" else (float(v) for v in raw)
+    span = abs(math.degrees(b - a))
+    if not 0 < span < 360:
+        problems.append(f"{key} = {raw!r}: the range must span more than 0 and less than 360 deg, got "
+                        f"{span:.10g} deg (for a full turn leave the range out and choose position 1 with "
+                        "[dynamics] start_deg or --start)")
+        return None
+    return a, b
+
+
+def _check_range_assembles(mech: Mechanism, data: Mapping[str, Any]) -> None:
+    """SchemeError naming the key, its value and the input angles of the declared range at which
+    the mechanism cannot be assembled (a range is where it assembles)."""
+    import numpy as np
+
+    from assur.base import CANNOT_ASSEMBLE
+
+    from .kinematics import analyze
+
+    a, b = mech.input_range
+    phi = np.linspace(a, b, RANGE_SWEEP)
+    with warnings.catch_warnings():  # mode changes are the analysis's to report, not the range's
+        warnings.simplefilter("ignore")
+        motion = analyze(mech, phi, order=0, on_failure="mask")
+    bad = np.flatnonzero(motion.status == CANNOT_ASSEMBLE)
+    if not len(bad):
+        return
+    key = "range_deg" if "range_deg" in data else "range"
+    deg = np.degrees(phi)
+    ok = np.flatnonzero(motion.status != CANNOT_ASSEMBLE)
+    runs = _runs(deg, bad)
+    assembles = f"; it assembles at {_runs(deg, ok)} deg" if len(ok) else "; it assembles nowhere in it"
+    raise SchemeError(f"{key} = {data[key]!r}: the mechanism cannot be assembled at phi = {runs} deg of "
+                      f"this range{assembles} (checked at {RANGE_SWEEP} angles): declare a range within "
+                      "which it assembles")
+
+
+def _runs(deg, index) -> str:
+    """Consecutive sweep indices as ``a..b`` angle spans (deg), joined by commas."""
+    spans, start = [], index[0]
+    for prev, cur in zip(index, list(index[1:]) + [None]):
+        if cur is None or cur != prev + 1:
+            lo, hi = deg[start], deg[prev]
+            spans.append(f"{lo:.4g}" if start == prev else f"{lo:.4g}..{hi:.4g}")
+            start = cur
+    return ", ".join(spans)
 
 
 def _table(data, key, problems, where="") -> dict:
@@ -366,6 +440,8 @@ def to_dict(mech: Mechanism) -> dict[str, Any]:
     data["inputs"] = list(mech.inputs)
     if mech.output is not None:
         data["output"] = {"quantity": mech.output.quantity, "start": mech.output.start}
+    if mech.input_range is not None:
+        data["range"] = list(mech.input_range)
     data["links"] = {}
     for name in sorted(mech.links):
         link = mech.links[name]

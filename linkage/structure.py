@@ -1,4 +1,4 @@
-"""Structural analysis: mobility (Chebyshev) and decomposition into Assur groups (METHOD 2).
+"""Structural analysis: mobility (Chebyshev) and decomposition into Assur groups (docs/methods.md#structure).
 
 Plain functions on a :class:`~linkage.model.Mechanism`:
 

@@ -23,7 +23,9 @@ def read_csv(text):
 
 
 def read_table(text):
-    lines = [ln for ln in text.splitlines() if ln.strip() and not ln.startswith("#")]
+    """The columns of a table for people: the names line, then (skipped) the line of units in
+    brackets, then the rows."""
+    lines = [ln for ln in text.splitlines() if ln.strip() and not ln.startswith("#") and "[" not in ln]
     header = lines[0].split()
     data = np.array([[float(x) for x in ln.split()] for ln in lines[1:]])
     return {name: data[:, k] for k, name in enumerate(header)}

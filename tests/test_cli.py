@@ -80,7 +80,7 @@ def test_schemes_lists_every_shipped_scheme(capsys):
     lines = out.splitlines()
     assert [ln.split()[0] for ln in lines] == SHIPPED
     by_name = {ln.split()[0]: ln for ln in lines}
-    # structural formulas known from the course (METHOD section 4 examples)
+    # structural formulas known from the course (docs/methods.md#structure)
     expected = {"slider_crank": "I(0,1) → II-RRP(2,3)", "four_bar": "I(0,1) → II-RRR(2,3)",
                 "slotted_link": "II-RPR", "scotch_yoke": "II-RPP",
                 "slotted_link_two_dyad": "I(0,1) → II-RPR(2,3) → II-PRP(4,5)"}
@@ -107,7 +107,7 @@ def test_analyze_formats_agree_and_have_the_contract_columns(capsys, scheme):
 
     cols = read_csv(out_csv)
     names = list(cols)
-    assert names[0] == "phi_deg"
+    assert names[:2] == ["i", "phi_deg"]
     # the contract: points (x y x' y' x'' y''), moving links (theta ...), prismatic slides (s ...)
     for p in mech.point_names:
         assert [n for n in names if n.rpartition(".")[0] == p] == \
@@ -117,42 +117,57 @@ def test_analyze_formats_agree_and_have_the_contract_columns(capsys, scheme):
     prismatic = [k for k, p in mech.pairs.items() if type(p).__name__ == "Prismatic"]
     for k in prismatic:
         assert f"{k}.s" in names and f"{k}.s'" in names and f"{k}.s''" in names
-    assert len(names) == 1 + 6 * len(mech.point_names) + 3 * len(mech.moving_links) + 3 * len(prismatic)
+    assert len(names) == 2 + 6 * len(mech.point_names) + 3 * len(mech.moving_links) + 3 * len(prismatic)
 
-    # 12 equal steps, rows 1..13, row 13 = row 1 + 360 deg
-    phi = cols["phi_deg"]
-    assert len(phi) == 13
-    # positions follow the declared sense of rotation (the [dynamics] mean speed), else CCW
+    # n equal steps (the scheme's [dynamics] positions, else 12), rows 1..n+1, row n+1 = row 1
+    # + 360 deg; phi_deg counts from position 1 in the direction of rotation: 0 .. 360
     dyn = mech.extra.get("dynamics") or {}
+    n = dyn.get("positions", 12)
+    phi = cols["phi_deg"]
+    assert len(phi) == n + 1
+    np.testing.assert_array_equal(cols["i"], np.arange(1, n + 2))
+    np.testing.assert_allclose(phi, 360.0 / n * np.arange(n + 1), rtol=0, atol=1e-9)
+    # the input link's angle is the absolute input angle phi0 + s phi_deg, in (-pi, pi], with the
+    # sense s of the declared mean speed (else CCW)
     sense = -1.0 if dyn.get("mean_speed", dyn.get("mean_rpm", 1)) < 0 else 1.0
-    np.testing.assert_allclose(np.diff(phi), sense * 30.0, rtol=0, atol=1e-9)
-    # the input link's angle is phi itself (METHOD section 1), up to whole turns
-    turns = np.angle(np.exp(1j * (cols[f"{mech.inputs[0]}.theta"] - np.radians(phi))))
-    np.testing.assert_allclose(turns, 0.0, rtol=0, atol=1e-12)
-    # position 13 is position 1 again
+    doc = json.loads(out_json)
+    assert doc["direction"] == sense
+    absolute = np.radians(doc["phi0_deg"] + sense * phi)
+    theta1 = cols[f"{mech.inputs[0]}.theta"]
+    np.testing.assert_allclose(np.angle(np.exp(1j * (theta1 - absolute))), 0.0, rtol=0, atol=1e-12)
+    for name in names:
+        if name.endswith(".theta"):
+            assert np.all((cols[name] > -math.pi) & (cols[name] <= math.pi)), name
+    # position n+1 is position 1 again
     for name, values in cols.items():
-        if name == "phi_deg":
+        if name in ("i", "phi_deg"):
             continue
         if name.endswith(".theta"):
             gap = np.angle(np.exp(1j * (values[-1] - values[0])))
             assert abs(gap) < 1e-9, name
         else:
             assert values[-1] == pytest.approx(values[0], abs=1e-9), name
-    # JSON: the same numbers (exactly) with the metadata
-    doc = json.loads(out_json)
+    # JSON: the same numbers (exactly) with the metadata and the units
     assert doc["scheme"] == mech.name
-    assert len(doc["rows"]) == 13
+    assert len(doc["rows"]) == n + 1
+    assert doc["units"]["phi_deg"] == "deg" and "i" not in doc["units"]
     for k, row in enumerate(doc["rows"]):
         assert list(row) == names
-        assert all(row[n] == cols[n][k] for n in names)
-    # table: the same numbers to the printed 7 significant digits
+        assert all(row[c] == cols[c][k] for c in names)
+    # table for people: a selection of the same numbers to the printed 7 significant digits, at
+    # most 160 characters wide, without the (constant) frame points, units under the names
     table = read_table(out_table)
-    assert list(table) == names
+    assert list(table)[:2] == ["i", "phi_deg"] and set(table) <= set(names)
+    frame_points = set(mech.links[mech.frame].points)
+    assert not {c.rpartition(".")[0] for c in table} & frame_points
     scale = max(np.abs(v).max() for v in cols.values())
-    for n in names:
-        np.testing.assert_allclose(table[n], cols[n], rtol=1e-6, atol=1e-11 * scale, err_msg=n)
-    header = [ln for ln in out_table.splitlines() if not ln.startswith("#")]
-    assert len({len(ln) for ln in header}) == 1  # aligned: every line equally wide
+    for c in table:
+        np.testing.assert_allclose(table[c], cols[c], rtol=1e-6, atol=1e-11 * scale, err_msg=c)
+    body = [ln for ln in out_table.splitlines() if not ln.startswith("#")]
+    assert len({len(ln) for ln in body}) == 1  # aligned: every line equally wide
+    assert len(body[0]) <= 160
+    assert body[1].split()[0] == "[deg]"  # the units line: i has none, phi_deg is in deg
+    assert any(ln.startswith("# columns:") and "--columns '*'" in ln for ln in out_table.splitlines())
 
 
 @pytest.mark.parametrize("scheme", SHIPPED)
@@ -171,16 +186,18 @@ def test_default_start_is_the_declared_extreme(capsys, scheme):
 
 @pytest.mark.parametrize("scheme", SHIPPED)
 def test_analogs_match_finite_differences_of_positions(capsys, scheme):
-    """x' and x'' of every column against five-point differences of the positions (METHOD 8)."""
+    """x' and x'' of every column against five-point differences of the positions (docs/methods.md#checks)."""
     phi0_deg, h_deg = 17.0, 0.5
     samples = [analyze_csv(capsys, scheme, "--positions", "1", "--start", repr(phi0_deg + k * h_deg))
                for k in (-2, -1, 0, 1, 2)]
     h = math.radians(h_deg)
     at = {n: np.array([s[n][0] for s in samples]) for n in samples[0]}
-    assert at["phi_deg"][2] == phi0_deg
+    assert at["phi_deg"][2] == 0.0  # position 1 ...
+    theta1 = at[f"{linkage.load(scheme).inputs[0]}.theta"][2]
+    assert theta1 == pytest.approx(math.radians(phi0_deg), abs=1e-15)  # ... is at the given angle
     size = max(np.abs(at[n]).max() for n in at if n.endswith((".x", ".y", ".s")))
     for name in at:
-        if name == "phi_deg" or name.endswith("'"):
+        if name in ("i", "phi_deg") or name.endswith("'"):
             continue
         values = np.unwrap(at[name]) if name.endswith(".theta") else at[name]
         d1 = (values[0] - 8 * values[1] + 8 * values[3] - values[4]) / (12 * h)
@@ -197,13 +214,14 @@ def test_analogs_match_finite_differences_of_positions(capsys, scheme):
 
 def test_slider_crank_against_the_closed_form(capsys):
     cols = analyze_csv(capsys, "slider_crank")
-    # position 1: the far dead centre, crank and rod in line
+    # position 1: the far dead centre, crank and rod in line; then 30 deg steps CCW
     phi0 = math.degrees(math.asin(E_OFF / (L1 + L2)))
-    assert cols["phi_deg"][0] == pytest.approx(phi0, abs=1e-9)
-    assert cols["phi_deg"][-1] == pytest.approx(phi0 + 360.0, abs=1e-9)
+    np.testing.assert_array_equal(cols["phi_deg"], 30.0 * np.arange(13))
+    assert cols["1.theta"][0] == pytest.approx(math.radians(phi0), abs=1e-12)
     assert cols["B.x"][0] == pytest.approx(math.sqrt((L1 + L2) ** 2 - E_OFF**2), abs=1e-12)
     # every position
-    phi = np.radians(cols["phi_deg"])
+    phi = np.radians(phi0 + cols["phi_deg"])
+    np.testing.assert_allclose(np.angle(np.exp(1j * (cols["1.theta"] - phi))), 0.0, atol=1e-12)
     np.testing.assert_allclose(cols["A.x"], L1 * np.cos(phi), atol=1e-12)
     np.testing.assert_allclose(cols["A.y"], L1 * np.sin(phi), atol=1e-12)
     np.testing.assert_allclose(cols["B.x"], slider_crank_B_x(phi), atol=1e-12)
@@ -228,9 +246,9 @@ def test_four_bar_starts_at_the_rocker_extreme_and_follows_the_geometry(capsys):
     bx = (r**2 - FB_CB**2 + FB_C[0] ** 2) / (2 * FB_C[0])
     B0 = np.array([bx, math.sqrt(r**2 - bx**2)])
     phi0 = math.degrees(math.atan2(B0[1], B0[0]) + math.pi) % 360.0
-    assert cols["phi_deg"][0] == pytest.approx(phi0, abs=1e-8)
+    assert math.degrees(cols["1.theta"][0]) % 360.0 == pytest.approx(phi0, abs=1e-8)
     assert cols["3.theta"][0] == pytest.approx(math.atan2(B0[1], B0[0] - FB_C[0]), abs=1e-12)
-    for k, phi in enumerate(np.radians(cols["phi_deg"])):
+    for k, phi in enumerate(np.radians(phi0 + cols["phi_deg"])):
         A, B = four_bar_B(phi)
         assert (cols["B.x"][k], cols["B.y"][k]) == pytest.approx(tuple(B), abs=1e-12)
         u = (B - A) / FB_AB
@@ -251,9 +269,9 @@ def test_two_dyad_slotted_link_against_the_geometry(capsys):
     theta3 = math.pi / 2 - math.asin(SL_R / d)
     A0 = math.sqrt(d**2 - SL_R**2) * np.array([math.cos(theta3), math.sin(theta3)])
     phi0 = math.degrees(math.atan2(A0[1] - SL_O1[1], A0[0] - SL_O1[0])) % 360.0
-    assert cols["phi_deg"][0] == pytest.approx(phi0, abs=1e-8)
+    assert math.degrees(cols["1.theta"][0]) % 360.0 == pytest.approx(phi0, abs=1e-8)
     assert cols["B.x"][0] == pytest.approx(SL_RAM_Y / math.tan(theta3), abs=1e-12)
-    phi = np.radians(cols["phi_deg"])
+    phi = np.radians(phi0 + cols["phi_deg"])
     A = SL_O1 + SL_R * np.column_stack([np.cos(phi), np.sin(phi)])
     rocker = A / np.linalg.norm(A, axis=1)[:, None]
     np.testing.assert_allclose(cols["B.x"], SL_RAM_Y * A[:, 0] / A[:, 1], atol=1e-12)
@@ -272,11 +290,12 @@ def test_two_dyad_slotted_link_against_the_geometry(capsys):
 
 def test_start_angle_and_number_of_positions(capsys):
     cols = analyze_csv(capsys, "slider_crank", "--start", "30")
-    assert cols["phi_deg"][0] == 30.0
+    assert cols["phi_deg"][0] == 0.0 and cols["1.theta"][0] == pytest.approx(math.radians(30), abs=1e-15)
     assert cols["A.x"][0] == pytest.approx(L1 * math.cos(math.radians(30)), abs=1e-15)
     assert cols["B.x"][0] == pytest.approx(slider_crank_B_x(math.radians(30)), abs=1e-12)
     cols = analyze_csv(capsys, "slider_crank", "--positions", "6", "--start", "30")
-    assert list(cols["phi_deg"]) == [30.0, 90.0, 150.0, 210.0, 270.0, 330.0, 390.0]
+    assert list(cols["phi_deg"]) == [0.0, 60.0, 120.0, 180.0, 240.0, 300.0, 360.0]
+    np.testing.assert_allclose(cols["A.x"], L1 * np.cos(np.radians(30.0 + cols["phi_deg"])), atol=1e-15)
     cols = analyze_csv(capsys, "four_bar", "--positions", "6")
     assert len(cols["phi_deg"]) == 7
     np.testing.assert_allclose(np.diff(cols["phi_deg"]), 60.0, atol=1e-9)
@@ -294,8 +313,10 @@ def test_json_metadata(capsys):
     assert code == 0, err
     doc = json.loads(out)
     assert doc["scheme"] == "slider_crank"
-    assert doc["positions"] == 4 and doc["phi0_deg"] == 30.0 and doc["failed"] == []
-    assert [r["phi_deg"] for r in doc["rows"]] == [30.0, 120.0, 210.0, 300.0, 390.0]
+    assert doc["positions"] == 4 and doc["phi0_deg"] == pytest.approx(30.0, abs=1e-12)
+    assert doc["failed"] == [] and doc["direction"] == 1
+    assert [r["i"] for r in doc["rows"]] == [1, 2, 3, 4, 5]
+    assert [r["phi_deg"] for r in doc["rows"]] == [0.0, 90.0, 180.0, 270.0, 360.0]
 
 
 def test_help(capsys):
@@ -379,7 +400,9 @@ def test_positions_that_cannot_be_assembled_are_empty_and_named(capsys, tmp_path
     assert "no output" in err and "0 deg" in err
     warning = [ln for ln in err.splitlines() if "cannot be assembled" in ln]
     assert len(warning) == 1
-    named = [float(x) for x in warning[0].split("=")[-1].split(":")[0].split(",")]
+    numbers = warning[0].split("positions i = ")[1].split(" (")[0]
+    assert [int(x) for x in numbers.split(",")] == list(np.flatnonzero(broken) + 1)
+    named = [float(x) for x in warning[0].split("phi = ")[1].split(" deg")[0].split(",")]
     assert named == pytest.approx(list(phi_deg[broken]))
     cols = read_csv(out)
     np.testing.assert_array_equal(cols["phi_deg"], phi_deg)

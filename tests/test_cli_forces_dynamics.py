@@ -3,9 +3,10 @@
 The oracles are written here from the textbook: the slider-crank's closed-form kinematics with
 analytic first and second analogs, the course's group-by-group force analysis of the RRP dyad and
 the crank, statics of the four-bar by virtual work (finite differences of its closed-form
-positions), and Mertsalov's flywheel method (METHOD sections 5 and 6). No number compared here is
+positions), and Mertsalov's flywheel method (docs/methods.md). No number compared here is
 copied from the library's output; the only inputs taken from the output are the independent
-variables of a row (phi_deg) and, to close the loop, a row's own omega / eps / reduced moment
+variables of a row (phi_deg, the angle from position 1 in the direction of rotation, with the
+start phi0) and, to close the loop, a row's own omega / eps / reduced moment
 where the check is "the other columns follow from these".
 """
 
@@ -195,14 +196,16 @@ def test_forces_every_scheme_every_format(capsys, scheme):
     assert "Traceback" not in err_csv + err_table + err_json
 
     cols = read_csv(out_csv)
-    expected = ["phi_deg", "balancing_moment"] + [f"{k}.{c}" for k in pairs for c in ("R", "angle_deg")]
-    assert sorted(cols) == sorted(expected)
-    assert list(cols)[:2] == ["phi_deg", "balancing_moment"]
-    assert len(cols["phi_deg"]) == 13
-    # JSON: the same numbers plus the components (and K.M for prismatic pairs)
+    expected = ["i", "phi_deg", "balancing_moment"] + [f"{k}.{c}" for k in pairs for c in ("R", "angle_deg")]
+    # CSV and JSON: every column, the components (and K.M for prismatic pairs) too
     extra = [f"{k}.{c}" for k in pairs for c in ("Rx", "Ry")] + [f"{k}.M" for k in prismatic]
+    assert sorted(cols) == sorted(expected + extra)
+    assert list(cols)[:3] == ["i", "phi_deg", "balancing_moment"]
+    n = (mech.extra.get("dynamics") or {}).get("positions", 12)  # the scheme's, else 12
+    assert len(cols["phi_deg"]) == n + 1
+    np.testing.assert_allclose(cols["phi_deg"], 360.0 / n * np.arange(n + 1), rtol=0, atol=1e-9)
     assert sorted(full) == sorted(expected + extra)
-    for name in expected:
+    for name in expected + extra:
         np.testing.assert_array_equal(full[name], cols[name], err_msg=name)
     for k in pairs:
         np.testing.assert_allclose(full[f"{k}.R"], np.hypot(full[f"{k}.Rx"], full[f"{k}.Ry"]),
@@ -213,10 +216,13 @@ def test_forces_every_scheme_every_format(capsys, scheme):
         np.testing.assert_allclose(gap[nonzero], 0.0, atol=1e-12, err_msg=k)
     assert doc["scheme"] == mech.name
     assert doc["virtual_power_residual_max"] < 1e-9
-    # table: the same numbers to the printed digits
+    for k in pairs:  # directions in (-180, 180]
+        assert np.all((full[f"{k}.angle_deg"] > -180) & (full[f"{k}.angle_deg"] <= 180)), k
+    # table: the balancing moment and some reactions, the same numbers to the printed digits
     table = read_table(out_table)
-    assert list(table) == list(cols)
-    for name in cols:
+    assert list(table)[:3] == ["i", "phi_deg", "balancing_moment"] and set(table) <= set(cols)
+    assert max(len(ln) for ln in out_table.splitlines() if not ln.startswith("#")) <= 160
+    for name in table:
         scale = np.abs(cols[name]).max()
         np.testing.assert_allclose(table[name], cols[name], rtol=1e-6, atol=1e-9 * scale, err_msg=name)
     assert any(ln.startswith("# virtual_power_residual_max") for ln in out_table.splitlines())
@@ -259,7 +265,9 @@ def test_forces_rpm_60_is_omega_two_pi(capsys):
 def test_forces_four_bar_static_against_virtual_work(capsys):
     doc, cols, err = json_doc(capsys, "forces", "four_bar", "--positions", "24")
     assert doc["omega"] is None and "static analysis" in err
-    expected = np.array([four_bar_static_moment(p) for p in np.radians(cols["phi_deg"])])
+    assert doc["direction"] == 1  # no speed, no [dynamics]: counter-clockwise
+    phi_abs = np.radians(doc["phi0_deg"] + cols["phi_deg"])
+    expected = np.array([four_bar_static_moment(p) for p in phi_abs])
     np.testing.assert_allclose(cols["balancing_moment"], expected, rtol=0,
                                atol=1e-8 * np.abs(expected).max())
     # equilibrium of the whole mechanism: frame forces carry the weight (6 kg), moments about O
@@ -268,7 +276,7 @@ def test_forces_four_bar_static_against_virtual_work(capsys):
     R_frame_on_rocker = np.stack([cols["C.Rx"], cols["C.Ry"]], -1)
     total = R_frame_on_crank + R_frame_on_rocker
     np.testing.assert_allclose(total, np.tile([0.0, 6.0 * G], (len(total), 1)), atol=1e-9)
-    for k, phi in enumerate(np.radians(cols["phi_deg"])):
+    for k, phi in enumerate(phi_abs):
         A, B = four_bar(phi)
         moments = (cols["balancing_moment"][k] + cross(FB_C, R_frame_on_rocker[k])
                    + cross((A + B) / 2, np.array([0.0, -FB_M2 * G]))
@@ -284,8 +292,8 @@ def test_forces_slider_crank_against_the_course_force_analysis(capsys, omega, ep
     assert "static" not in err
     # rows: from the far dead centre in the sense of omega (CCW for 0: no [dynamics]), 30 deg steps
     sense = -1.0 if omega < 0 else 1.0
-    np.testing.assert_allclose(cols["phi_deg"], PHI0_DEG + sense * 30.0 * np.arange(13), atol=1e-9)
-    check_slider_crank_reactions(cols, np.radians(cols["phi_deg"]), omega, eps, 0.0)
+    np.testing.assert_allclose(cols["phi_deg"], 30.0 * np.arange(13), atol=1e-9)
+    check_slider_crank_reactions(cols, np.radians(PHI0_DEG + sense * cols["phi_deg"]), omega, eps, 0.0)
     assert doc["virtual_power_residual_max"] < 1e-9
 
 
@@ -299,7 +307,7 @@ def test_forces_eps_without_a_speed_is_not_silently_dropped(capsys):
     assert code == 0, err
     doc = json.loads(out)
     cols = {k: np.array([r[k] for r in doc["rows"]]) for k in doc["rows"][0]}
-    expected = slider_crank_forces(np.radians(cols["phi_deg"]), 0.0, doc["eps"], 0.0)
+    expected = slider_crank_forces(np.radians(PHI0_DEG + cols["phi_deg"]), 0.0, doc["eps"], 0.0)
     close(cols["balancing_moment"], expected["balancing_moment"])
 
 
@@ -308,17 +316,17 @@ def test_forces_course_scheme_uses_its_mean_speed_and_force_cycle(capsys):
     (position 13 carries the end-of-stroke value)."""
     doc, cols, err = json_doc(capsys, "forces", "course_slider_crank")
     assert doc["omega"] == W_M and doc["notes"] == [] and "static" not in err
-    np.testing.assert_allclose(cols["phi_deg"], PHI0_DEG - 30.0 * np.arange(13), atol=1e-9)
-    check_slider_crank_reactions(cols, np.radians(cols["phi_deg"]), W_M, 0.0, CYCLE)
+    np.testing.assert_allclose(cols["phi_deg"], 30.0 * np.arange(13), atol=1e-9)
+    check_slider_crank_reactions(cols, np.radians(PHI0_DEG - cols["phi_deg"]), W_M, 0.0, CYCLE)
 
 
 def test_forces_course_scheme_between_the_cycle_positions(capsys):
     """24 positions: the cycle force is linear in the cycle angle between the 13 given values."""
     doc, cols, _ = json_doc(capsys, "forces", "course_slider_crank", "--positions", "24")
     assert len(doc["rows"]) == 25
-    np.testing.assert_allclose(cols["phi_deg"], PHI0_DEG - 15.0 * np.arange(25), atol=1e-9)
+    np.testing.assert_allclose(cols["phi_deg"], 15.0 * np.arange(25), atol=1e-9)
     force = np.interp(15.0 * np.arange(25), 30.0 * np.arange(13), CYCLE)
-    check_slider_crank_reactions(cols, np.radians(cols["phi_deg"]), W_M, 0.0, force)
+    check_slider_crank_reactions(cols, np.radians(PHI0_DEG - cols["phi_deg"]), W_M, 0.0, force)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -366,9 +374,10 @@ def test_dynamics_course_slider_crank_against_mertsalov(capsys):
     for name in DYNAMICS_COLUMNS:
         assert name in cols, name
     assert len(doc["rows"]) == 13
-    # rows start at the far dead centre and go clockwise
-    np.testing.assert_allclose(cols["phi_deg"], PHI0_DEG - 30.0 * np.arange(13), atol=1e-9)
-    phi = np.radians(cols["phi_deg"])
+    # rows start at the far dead centre and go clockwise; phi_deg counts the angle travelled
+    np.testing.assert_allclose(cols["phi_deg"], 30.0 * np.arange(13), atol=1e-9)
+    np.testing.assert_array_equal(cols["i"], np.arange(1, 14))
+    phi = np.radians(PHI0_DEG - cols["phi_deg"])
     # the reduced moment of resistance and the reduced inertia from the closed form
     close(cols["reduced_moment_resistance"], reduced_resistance(phi))
     ref = mertsalov(cols["reduced_moment_resistance"], DELTA)
@@ -422,9 +431,12 @@ def test_dynamics_table_prints_the_summary_and_the_rows(capsys):
                for ln in out.splitlines() if ln.startswith("# ")}
     assert summary["scheme"] == "course_slider_crank" and summary["method"] == "course"
     for key in DYNAMICS_KEYS:
-        assert float(summary[key]) == pytest.approx(doc[key], rel=1e-5), key
+        assert float(summary[key].split()[0]) == pytest.approx(doc[key], rel=1e-5), key
+    # with their units
+    assert summary["driving_moment"].endswith(" N m") and summary["flywheel_inertia"].endswith(" kg m^2")
+    assert summary["delta_actual"].split() == [summary["delta_actual"]]  # a pure number
     table = read_table(out)
-    assert list(table) == list(cols)
+    assert list(table) == list(cols)  # every column fits in 160 characters
     for name in cols:
         scale = np.abs(cols[name]).max()
         np.testing.assert_allclose(table[name], cols[name], rtol=1e-6, atol=1e-9 * scale, err_msg=name)
@@ -451,7 +463,7 @@ def test_dynamics_overrides_on_a_scheme_without_dynamics(capsys):
 def test_dynamics_omega_and_delta_override_the_scheme(capsys):
     doc, cols, _ = json_doc(capsys, "dynamics", "course_slider_crank", "--omega", "-5",
                             "--delta", "0.1")
-    close(cols["reduced_moment_resistance"], reduced_resistance(np.radians(cols["phi_deg"])))
+    close(cols["reduced_moment_resistance"], reduced_resistance(np.radians(PHI0_DEG - cols["phi_deg"])))
     ref = mertsalov(cols["reduced_moment_resistance"], 0.1, mean_speed=-5.0)
     assert ref["flywheel"] > 0
     assert doc["driving_moment"] == pytest.approx(ref["driving"], rel=1e-9)
@@ -466,7 +478,7 @@ def test_dynamics_rpm_overrides_the_sense_of_rotation(capsys):
     """--rpm overrides the declared mean speed, sign included: positions then go CCW."""
     doc, cols, _ = json_doc(capsys, "dynamics", "course_slider_crank", "--rpm", "50")
     assert np.all(cols["omega"] > 0)
-    np.testing.assert_allclose(cols["phi_deg"], PHI0_DEG + 30.0 * np.arange(13), atol=1e-9)
+    np.testing.assert_allclose(cols["phi_deg"], 30.0 * np.arange(13), atol=1e-9)
     w = np.abs(cols["omega"])
     wm = 50 * 2 * math.pi / 60
     assert (w.max() + w.min()) / 2 == pytest.approx(wm, rel=1e-2)

@@ -1,6 +1,6 @@
 """Tests of the five class-II group (dyad) solvers of :mod:`assur` against independent oracles.
 
-Every expected number here is computed in this file from the joints' local geometry (METHOD
+Every expected number here is computed in this file from the joints' local geometry (docs/methods.md
 sections 3, 4 and 8), never read back from the solvers:
 
 1. per kind, the solver against textbook geometry written here (circle-circle, circle-line,
@@ -54,7 +54,7 @@ TWO_PI = 2 * np.pi
 
 
 # ==============================================================================================
-# independent plane geometry (METHOD section 3), written without the library's helpers
+# independent plane geometry (docs/methods.md#analogs), written without the library's helpers
 # ==============================================================================================
 
 
@@ -268,7 +268,7 @@ def cases(draw, kind):
 
 
 # ==============================================================================================
-# textbook geometry per kind (METHOD section 4, derived independently)
+# textbook geometry per kind (docs/methods.md#positions-the-five-dyads, derived independently)
 # ==============================================================================================
 
 
@@ -547,7 +547,7 @@ def _slider_crank(l1, l2, e, towards=0.0):
 
 
 def test_slider_crank_textbook_formulas_through_analyze():
-    """METHOD 8: x_B = l1 cos phi + sqrt(l2^2 - (l1 sin phi - e)^2), i21 = -l1 cos phi /
+    """docs/methods.md#checks: x_B = l1 cos phi + sqrt(l2^2 - (l1 sin phi - e)^2), i21 = -l1 cos phi /
     (l2 cos theta2), x_B' = -l1 sin phi - l2 sin theta2 i21, through the builder and analyze."""
     l1, l2, e = 0.0742, 0.2225, 0.01335
     phi = np.linspace(0, TWO_PI, 25)
@@ -765,7 +765,7 @@ def test_contract_scale_invariance(kind, data, log_k):
 @SETTINGS_40
 @given(data=st.data())
 def test_contract_mirror_symmetry(kind, data):
-    """Mirroring the dyad and its known links in the x axis mirrors the solution (METHOD 8).
+    """Mirroring the dyad and its known links in the x axis mirrors the solution (docs/methods.md#checks).
     RRR changes branch (left of A->C becomes right); RRP and RPR keep it (their branch is an
     along-guide direction, which the mirror keeps)."""
     case = data.draw(cases(kind))

@@ -1,6 +1,6 @@
-"""Machine dynamics (METHOD sections 6, 7, 8) against oracles written independently in this file.
+"""Machine dynamics (docs/methods.md) against oracles written independently in this file.
 
-Every expected number is derived here: closed-form slider-crank kinematics (METHOD section 8),
+Every expected number is derived here: closed-form slider-crank kinematics (docs/methods.md#checks),
 finite differences of positions, the course formulas re-evaluated step by step, our own trapezoid
 and Simpson quadratures, the virtual-power balance and conservation of energy. No value is copied
 from the library's output.
@@ -19,7 +19,7 @@ from the library's output.
 9. The virtual-power balance under the real law of motion, and ``M_b = s M_d - I_c eps``.
 10. The summary (JSON keys of ``linkage dynamics``).
 
-Convention (METHOD section 6): ``s = sign(omega_m)``, ``psi = s phi``; reduced moments are
+Convention (docs/methods.md#reduced-moment-and-moment-of-inertia): ``s = sign(omega_m)``, ``psi = s phi``; reduced moments are
 positive when they drive; ``w = |omega|``.
 """
 
@@ -62,7 +62,7 @@ PHI0 = math.asin(E / (L1 + L2))                     # far extreme position of th
 
 
 def slider_crank_closed(phi):
-    """Closed-form analogs of the offset slider-crank (METHOD section 8).
+    """Closed-form analogs of the offset slider-crank (docs/methods.md#checks).
 
     Returns ``i21``, ``x_B'``, ``S2'`` (N, 2) and ``I''`` = m2 |S2'|^2 + J2 i21^2 + m3 x_B'^2."""
     phi = np.asarray(phi, float)

@@ -1,7 +1,7 @@
 """Dynamics at the edges (issue 7): degenerate ratios, extreme arguments, typed errors.
 
 Every expected value comes from an independent oracle written here: closed-form slider-crank
-kinematics (METHOD section 8), the tangency condition of a slotted link's stroke ends, the
+kinematics (docs/methods.md#checks), the tangency condition of a slotted link's stroke ends, the
 cycle balance of conservative and constant loads, Kloss's formula and its linear limit, the
 proportionality of Mertsalov's inertia to 1 / delta, and the constant speed a huge flywheel
 imposes at the motor's balance point.
@@ -128,7 +128,7 @@ F_SLIDER = -1000.0                     # N along x on the slider
 
 
 def slider_x1(phi):
-    """``x_B'`` of the offset slider-crank, closed form (METHOD section 8)."""
+    """``x_B'`` of the offset slider-crank, closed form (docs/methods.md#checks)."""
     sin2 = (E - L1 * np.sin(phi)) / L2
     cos2 = np.sqrt(1 - sin2**2)
     i21 = -L1 * np.cos(phi) / (L2 * cos2)
@@ -213,9 +213,12 @@ def test_residual_without_any_load():
 # ----------------------------------------------------------------------------------------------
 
 
-def test_initial_speed_zero_is_a_typed_error(shears):
-    with pytest.raises(DynamicsInputError, match=r"initial_speed must be .* got 0") as info:
-        simulate(shears, initial_speed=0)
+def test_initial_speed_zero_without_a_starting_torque_is_a_typed_error(shears):
+    """A start from rest (initial_speed = 0) needs a motor with a starting torque
+    (tests/test_scheme_format.py); a constant motor of 0 N m has none."""
+    no_torque = replace(dynamics_of(shears), motor=ConstantMotor(0.0))
+    with pytest.raises(DynamicsInputError, match=r"initial_speed = 0 .* starting torque") as info:
+        simulate(shears, no_torque, initial_speed=0)
     assert isinstance(info.value, LinkageError) and isinstance(info.value, ValueError)
     assert isinstance(info.value, DynamicsError)
 

@@ -1,7 +1,7 @@
-"""Kinetostatics (METHOD section 5) against oracles written independently in this file.
+"""Kinetostatics (docs/methods.md#kinetostatics) against oracles written independently in this file.
 
 1. The course's step-by-step algorithm for the slider-crank (horizontal guide, and the same press
-   turned upright), with closed-form kinematics (METHOD section 8) computed here, never taken from
+   turned upright), with closed-form kinematics (docs/methods.md#checks) computed here, never taken from
    the library's analogs or accelerations.
 2. Zhukovsky's virtual power balance for every shipped scheme with gravity, inertia, an external
    force and an external moment, evaluated by the library *and* recomputed here from the loads.
@@ -60,7 +60,7 @@ def rel_err(actual, expected):
 
 
 # ----------------------------------------------------------------------------------------------
-# independent slider-crank kinematics (METHOD sections 4 and 8)
+# independent slider-crank kinematics (docs/methods.md#positions-the-five-dyads, #checks)
 # ----------------------------------------------------------------------------------------------
 
 
@@ -188,7 +188,7 @@ def test_oracle_kinematics_self_consistent(geometry):
 
 
 def test_oracle_kinematics_match_method_formulas():
-    """Horizontal case: METHOD section 8's textbook formulas for x_B, i21 and x_B'."""
+    """Horizontal case: the textbook formulas for x_B, i21 and x_B'."""
     kin = slider_crank_kinematics(PHI, **HORIZONTAL)
     xB = L1 * np.cos(PHI) + np.sqrt(L2**2 - (L1 * np.sin(PHI) - OFFSET) ** 2)
     th2 = kin["th2"]

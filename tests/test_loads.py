@@ -1,9 +1,9 @@
-"""Loads (METHOD sections 5 and 7): force diagrams over the working stroke, their two values at a
+"""Loads (docs/methods.md#kinetostatics, #loads): force diagrams over the working stroke, their two values at a
 stroke end, the declaration errors of ``[loads]``, notes on missing masses, and gravity off.
 
 Every expected value is computed here: the press's stroke ends from the collinear positions of
 crank and rod (x_B = sqrt((l2 +- l1)^2 - e^2)), stroke fractions from the closed-form x_B(phi), the
-direction of motion from the textbook analog x_B' times the sign of omega (METHOD sections 1, 8).
+direction of motion from the textbook analog x_B' times the sign of omega (docs/conventions.md, docs/methods.md#checks).
 """
 
 from __future__ import annotations
@@ -37,7 +37,7 @@ def x_b(phi):
 
 
 def x_b_analog(phi):
-    """METHOD section 8: x_B' = -l1 sin(phi) - l2 sin(theta2) i21, i21 = -l1 cos(phi)/(l2 cos(theta2))."""
+    """docs/methods.md#checks: x_B' = -l1 sin(phi) - l2 sin(theta2) i21, i21 = -l1 cos(phi)/(l2 cos(theta2))."""
     phi = np.asarray(phi, float)
     th2 = np.arcsin((E - L1 * np.sin(phi)) / L2)
     i21 = -L1 * np.cos(phi) / (L2 * np.cos(th2))
@@ -80,7 +80,7 @@ def slider_load(mech, phi, omega, ends=None):
 
 
 def expected_slider_load(phi, omega, working, fractions, values, opposes=True, idle=None):
-    """Physical meaning of METHOD section 7, computed independently of the library."""
+    """Physical meaning of docs/methods.md#loads, computed independently of the library."""
     x, v = x_b(phi), x_b_analog(phi) * omega  # real velocity of B along x
     assert np.all(np.abs(v) > 1e-6), "test positions must avoid the stroke ends"
     t = (x - X_MIN) / STROKE if working > 0 else (X_MAX - x) / STROKE
@@ -252,9 +252,14 @@ BAD_LOADS = {
     "fractions decreasing": (
         {"forces": [diagram_force(dict(working="+", fractions=[0, 0.6, 0.4, 1], values=[0, 1, 1, 0]))]},
         ["forces[0]", "fractions", "[0, 0.6, 0.4, 1]"]),
-    "fractions repeated": (
-        {"forces": [diagram_force(dict(working="+", fractions=[0, 0.5, 0.5, 1], values=[0, 1, 2, 0]))]},
-        ["forces[0]", "fractions"]),
+    # a fraction given twice is a jump (a step diagram, tests/test_scheme_format.py); three times,
+    # or twice at a stroke end, cannot be meant
+    "fraction given three times": (
+        {"forces": [diagram_force(dict(working="+", fractions=[0, 0.5, 0.5, 0.5, 1], values=[0, 1, 2, 3, 0]))]},
+        ["forces[0]", "fractions", "three times", "[0, 0.5, 0.5, 0.5, 1]"]),
+    "stroke end repeated": (
+        {"forces": [diagram_force(dict(working="+", fractions=[0, 0.5, 1, 1], values=[0, 1, 2, 0]))]},
+        ["forces[0]", "fractions", "stroke end 1", "[0, 0.5, 1, 1]"]),
     "fractions above 1": (
         {"forces": [diagram_force(dict(working="+", fractions=[0, 0.5, 1.5], values=[0, 1, 0]))]},
         ["forces[0]", "fractions", "1.5"]),

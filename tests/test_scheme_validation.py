@@ -1,5 +1,5 @@
 """Every bad scheme declaration raises one :class:`linkage.SchemeError` whose message names the
-file, the entry and the offending value (STYLE 5); every shipped scheme round-trips through TOML.
+file, the entry and the offending value (every problem at once); every shipped scheme round-trips through TOML.
 
 The bad schemes are small edits of the four-bar and slider-crank texts below, written to
 ``tmp_path`` under a distinctive file name so that the message can be checked for it.

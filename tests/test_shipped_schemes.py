@@ -1,6 +1,6 @@
 """Every shipped scheme: it loads, decomposes as specified, closes its loops, has analogs that
 agree with finite differences, and survives a write/read round trip; plus oracles from closed-form
-formulas written here independently of the library (METHOD section 8).
+formulas written here independently of the library (docs/methods.md#checks).
 
 Reference numbers are computed in this file from the dimensions stated in each scheme's
 description (they are the spec), never copied from the library's output.
@@ -200,7 +200,7 @@ def test_roundtrip(name):
 
 
 # ----------------------------------------------------------------------------------------------
-# slider-crank, horizontal and vertical: textbook closed forms (METHOD section 8)
+# slider-crank, horizontal and vertical: textbook closed forms (docs/methods.md#checks)
 # ----------------------------------------------------------------------------------------------
 
 L1, L2, LAS2, ECC = 0.0742, 0.2225, 0.0741, 0.01335
@@ -256,7 +256,7 @@ def test_slider_crank_closed_form():
     S2 = A + LAS2 * np.column_stack([np.cos(th2), np.sin(th2)])
     np.testing.assert_allclose(mo.point("S2"), S2, rtol=0, atol=1e-14)
     np.testing.assert_allclose(mo.quantity("slide.s")[0], xB, rtol=0, atol=1e-14)
-    # METHOD section 8 form of x_B'
+    # docs/methods.md#checks form of x_B'
     np.testing.assert_allclose(xB1, -L1 * np.sin(PHI) - L2 * np.sin(th2) * i21, atol=1e-14)
 
 

@@ -1,4 +1,4 @@
-"""Structure (METHOD 2) and the structural invariants of kinematics (METHOD 8).
+"""Structure (docs/methods.md#structure) and the structural invariants of kinematics (docs/methods.md#checks).
 
 - mobility by Chebyshev's formula, counted by hand (``W = 3 n - 2 p``) for the shipped schemes;
 - structural formulas of the shipped schemes and of builder-made mechanisms, derived by hand;
@@ -46,7 +46,7 @@ HAND_MOBILITY = {
     "slotted_link_two_dyad": 3 * 5 - 2 * 7,  # links 1..5; pairs O1 A slot_A O3 slot_B B ram
 }
 
-#: structural formulas derived by hand from the scheme files (METHOD 2)
+#: structural formulas derived by hand from the scheme files (docs/methods.md#structure)
 HAND_FORMULA = {
     "four_bar": "I(0,1) → II-RRR(2,3)",
     "flying_shears": "I(0,1) → II-RRR(2,3)",
@@ -202,7 +202,7 @@ def test_mobility_mismatch_two_inputs():
 
 
 def test_mobility_mismatch_names_the_links():
-    """METHOD 2: "W != number of inputs is an error that names the links involved"."""
+    """docs/methods.md#structure: "W != number of inputs is an error that names the links involved"."""
     b = four_bar_builder()
     b.link("4", line=("E", "F"), length=0.1)
     b.revolute("E", "2", "4")

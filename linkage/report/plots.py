@@ -104,8 +104,21 @@ def plot_columns(columns: dict, names: Sequence[str], ax=None):
     for name in names:
         if name not in columns:
             raise InputError(f"no column {name!r}; columns: {list(columns)}")
-        ax.plot(phi, columns[name], label=name)
+        values = np.asarray(columns[name], dtype=float)
+        if name.endswith(".theta"):            # angles in (-pi, pi]: drawn as continuous curves
+            values = _unwrap(values, 2 * np.pi)
+        elif name.endswith("angle_deg"):
+            values = _unwrap(values, 360.0)
+        ax.plot(phi, values, label=name)
     ax.set_xlabel("phi, deg")
     ax.legend()
     ax.grid(True, alpha=0.3)
     return ax
+
+
+def _unwrap(values: np.ndarray, period: float) -> np.ndarray:
+    """Remove the jumps of a wrapped angle column (NaN rows kept as gaps)."""
+    out = values.copy()
+    ok = np.isfinite(values)
+    out[ok] = np.unwrap(values[ok], period=period)
+    return out

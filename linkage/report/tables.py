@@ -1,19 +1,30 @@
-"""Format a table of equal-length columns as aligned text, CSV or JSON.
+"""Format a table of equal-length columns as aligned text, CSV or JSON; units and selection of
+columns.
 
-A table is an ordered mapping ``name -> 1-D array`` (for analysis results the first column is
-``phi_deg``). Every command that prints a table (analyze, forces, dynamics ...) goes through
-:func:`format_columns`, so the three formats look the same everywhere:
+A table is an ordered mapping ``name -> 1-D array`` (for analysis results the first columns are
+``i``, the position number, and ``phi_deg``). Every command that prints a table (analyze, forces,
+dynamics ...) goes through :func:`format_columns`, so the three formats look the same everywhere:
 
-- ``table``: aligned, right-justified text for people, numbers to 7 significant digits;
+- ``table``: aligned, right-justified text for people, numbers to 7 significant digits; with
+  ``units``, a second header line gives each column's unit in brackets;
 - ``csv``: one header row, numbers at full precision (``repr``, round-trips exactly), ``nan``
   where a value is missing;
 - ``json``: a list of row objects ``{column: value}``; with ``meta``, an object
-  ``{**meta, "rows": [...]}``. Missing values (NaN, infinities) are written as ``null``.
+  ``{**meta, "rows": [...]}`` (with ``units``, also ``"units": {column: unit}``). Missing values
+  (NaN, infinities) are written as ``null``.
+
+The unit of a column follows from its name (:func:`column_unit`), and a selection of columns
+from a list of names and shell-style patterns (:func:`select_columns`).
 
 >>> import numpy as np
 >>> cols = {"phi_deg": np.array([0.0, 180.0]), "B.x": np.array([0.29, np.nan])}
 >>> print(format_columns(cols, "table"), end="")
 phi_deg   B.x
+      0  0.29
+    180   nan
+>>> print(format_columns(cols, "table", units=units_of(cols)), end="")
+phi_deg   B.x
+  [deg]   [m]
       0  0.29
     180   nan
 >>> format_columns(cols, "json", meta={"scheme": "demo"})
@@ -23,16 +34,17 @@ phi_deg   B.x
 from __future__ import annotations
 
 import csv
+import fnmatch
 import io
 import json
 import math
-from typing import Any, Mapping
+from typing import Any, Iterable, Mapping, Sequence
 
 import numpy as np
 
 from ..errors import InputError
 
-__all__ = ["FORMATS", "format_columns"]
+__all__ = ["FORMATS", "format_columns", "column_unit", "units_of", "select_columns", "table_width"]
 
 #: the output formats understood by :func:`format_columns`
 FORMATS = ("table", "csv", "json")
@@ -46,7 +58,8 @@ TABLE_ZERO = 1e-12
 
 
 def format_columns(columns: Mapping[str, Any], fmt: str = "table",
-                   meta: Mapping[str, Any] | None = None) -> str:
+                   meta: Mapping[str, Any] | None = None,
+                   units: Mapping[str, str | None] | None = None) -> str:
     """Text of a table of equal-length columns in the format ``fmt``.
 
     Parameters
@@ -58,6 +71,10 @@ def format_columns(columns: Mapping[str, Any], fmt: str = "table",
         Data about the table (scheme name, settings ...), JSON-serialisable values. ``json``:
         the result is ``{**meta, "rows": [...]}`` instead of a bare list of rows; ``table``: one
         ``# key: value`` line per entry above the table; ``csv``: not written (pure data).
+    units : mapping of str -> str or None, optional
+        Unit of each column (e.g. from :func:`units_of`; None or missing: no unit). ``table``: a
+        second header line ``[unit]``; ``json`` with ``meta``: a ``"units"`` entry; ``csv``: not
+        written (the header is the names only, as ``--columns`` takes them).
 
     Returns
     -------
@@ -69,9 +86,12 @@ def format_columns(columns: Mapping[str, Any], fmt: str = "table",
     cols = _check(columns)
     if fmt == "csv":
         return _csv(cols)
+    units = {k: v for k, v in (units or {}).items() if k in cols and v}
     if fmt == "json":
+        if meta is not None and units:
+            meta = {**meta, "units": units}
         return _json(cols, meta)
-    return _table(cols, meta)
+    return _table(cols, meta, units)
 
 
 def _check(columns: Mapping[str, Any]) -> dict[str, np.ndarray]:
@@ -149,12 +169,135 @@ def _scale(cols: dict[str, np.ndarray]) -> float:
     return float(max(f.max() for f in finite)) if finite else 0.0
 
 
-def _table(cols: dict[str, np.ndarray], meta: Mapping[str, Any] | None) -> str:
+def _table(cols: dict[str, np.ndarray], meta: Mapping[str, Any] | None,
+           units: Mapping[str, str] | None = None) -> str:
     scale = _scale(cols)
     cells = {name: _human(c, scale) for name, c in cols.items()}
-    widths = {name: max([len(name)] + [len(s) for s in cells[name]]) for name in cols}
+    heads = {name: f"[{units[name]}]" if units and units.get(name) else "" for name in cols}
+    widths = {name: max([len(name), len(heads[name])] + [len(s) for s in cells[name]]) for name in cols}
     lines = [f"# {k}: {v}" for k, v in (meta or {}).items()]
     lines.append("  ".join(name.rjust(widths[name]) for name in cols))
+    if any(heads.values()):
+        lines.append("  ".join(heads[name].rjust(widths[name]) for name in cols))
     for row in zip(*cells.values()):
         lines.append("  ".join(s.rjust(widths[name]) for name, s in zip(cols, row)))
     return "\n".join(lines) + "\n"
+
+
+def table_width(columns: Mapping[str, Any], units: Mapping[str, str | None] | None = None) -> int:
+    """Width in characters of the widest line of ``format_columns(columns, "table", units=units)``
+    (without metadata lines)."""
+    text = format_columns(columns, "table", units=units)
+    return max(len(line) for line in text.splitlines())
+
+
+# ----------------------------------------------------------------------------------------------
+# units of the columns
+# ----------------------------------------------------------------------------------------------
+
+#: units of whole column names
+_NAMED_UNITS = {
+    "t": "s",
+    "balancing_moment": "N m",
+    "reduced_moment_resistance": "N m",
+    "reduced_moment_driving": "N m",
+    "reduced_inertia": "kg m^2",
+    "reduced_inertia_derivative": "kg m^2/rad",
+    "omega": "rad/s",
+    "eps": "rad/s^2",
+}
+
+#: units of ``<object>.<quantity>`` columns by quantity, for the value, ``'`` and ``''``
+_QUANTITY_UNITS = {
+    "x": ("m", "m/rad", "m/rad^2"),        # point coordinates and their analogs
+    "y": ("m", "m/rad", "m/rad^2"),
+    "s": ("m", "m/rad", "m/rad^2"),        # slide of a prismatic pair
+    "theta": ("rad", "rad/rad", "rad/rad^2"),  # link angle and its analogs
+    "R": ("N",), "Rx": ("N",), "Ry": ("N",),  # pair reaction: magnitude, components
+    "M": ("N m",),                         # moment in a prismatic pair
+}
+
+
+def column_unit(name: str) -> str | None:
+    """The unit of a table column, from its name (None: a count or a pure number).
+
+    ``i`` none; ``*_deg`` deg; ``P.x P.y K.s`` m (with ``'`` m/rad, ``''`` m/rad^2);
+    ``L.theta`` rad (rad/rad, rad/rad^2); ``K.R K.Rx K.Ry`` N; ``K.M`` N m; ``balancing_moment``,
+    ``reduced_moment_*`` N m; ``reduced_inertia`` kg m^2; ``reduced_inertia_derivative``
+    kg m^2/rad; ``omega`` rad/s; ``eps`` rad/s^2; ``t`` s.
+
+    >>> [column_unit(n) for n in ("i", "phi_deg", "B.x'", "3.theta''", "A.R", "omega")]
+    [None, 'deg', 'm/rad', 'rad/rad^2', 'N', 'rad/s']
+    """
+    if name.endswith("_deg"):
+        return "deg"
+    if name in _NAMED_UNITS:
+        return _NAMED_UNITS[name]
+    _, dot, quantity = name.rpartition(".")
+    if not dot:
+        return None
+    base = quantity.rstrip("'")
+    order = len(quantity) - len(base)
+    units = _QUANTITY_UNITS.get(base, ())
+    return units[order] if order < len(units) else None
+
+
+def units_of(columns: Iterable[str]) -> dict[str, str | None]:
+    """``{name: column_unit(name)}`` for the given column names."""
+    return {name: column_unit(name) for name in columns}
+
+
+# ----------------------------------------------------------------------------------------------
+# selection of columns
+# ----------------------------------------------------------------------------------------------
+
+_WILDCARDS = set("*?[")
+
+
+def select_columns(columns: Mapping[str, Any], request: str | Sequence[str],
+                   always: Sequence[str] = ("i", "phi_deg")) -> dict[str, Any]:
+    """The columns a request names, in its order, after the ``always`` columns.
+
+    Parameters
+    ----------
+    columns : mapping of str -> array
+        Every column available.
+    request : str or sequence of str
+        Column names and shell-style patterns (``*``, ``?``, ``[seq]``; case-sensitive), as a
+        comma-separated string (``"B.*,3.theta"``) or a sequence. A pattern contributes its
+        matches in table order; a column already taken is not repeated.
+    always : sequence of str
+        Columns that lead every selection when the table has them (the position number and the
+        input angle).
+
+    Raises
+    ------
+    InputError
+        (a ``ValueError``) An empty request, or an entry that names no column (an unknown name, or
+        a pattern that matches nothing): the message names every such entry and lists the
+        available columns.
+
+    >>> cols = dict.fromkeys(["i", "phi_deg", "B.x", "B.y", "B.x'", "3.theta"], [0.0])
+    >>> list(select_columns(cols, "B.*,3.theta"))
+    ['i', 'phi_deg', 'B.x', 'B.y', "B.x'", '3.theta']
+    """
+    items = [r.strip() for r in (request.split(",") if isinstance(request, str) else request)]
+    items = [r for r in items if r]
+    if not items:
+        raise InputError(f"no column named: give names or patterns separated by commas; the columns are: "
+                         f"{', '.join(columns)}")
+    chosen = [name for name in always if name in columns]
+    missing = []
+    for item in items:
+        if _WILDCARDS & set(item):
+            matches = [name for name in columns if fnmatch.fnmatchcase(name, item)]
+        else:
+            matches = [item] if item in columns else []
+        if not matches:
+            missing.append(item)
+        chosen += [m for m in matches if m not in chosen]
+    if missing:
+        what = "; ".join(f"pattern {m!r} matches no column" if _WILDCARDS & set(m) else f"unknown column {m!r}"
+                         for m in missing)
+        raise InputError(f"{what}; the columns are: {', '.join(columns)}")
+    return {name: columns[name] for name in chosen}
