@@ -109,8 +109,9 @@ def place_group(group: Group, poses, branches: np.ndarray, input_error=0.0) -> G
 def assembly_plans(mech: Mechanism) -> tuple[BranchPlan, ...]:
     """The branch plan of every group of ``mech`` (cached on the mechanism).
 
-    A readable condition is evaluated on both candidate motions over a sweep of input angles;
-    the candidate that satisfies it at more positions wins.
+    A readable condition is evaluated on both candidate motions over a sweep of input angles (a
+    turn, or the mechanism's input range when it declares one); the candidate that satisfies it
+    at more positions wins.
 
     Raises
     ------
@@ -126,7 +127,10 @@ def assembly_plans(mech: Mechanism) -> tuple[BranchPlan, ...]:
         return cache["plans"]
     structure = structure_of(mech)
     rules = _rules_per_group(mech, structure)
-    phi = np.linspace(0.0, TWO_PI, BRANCH_SWEEP, endpoint=False)
+    if mech.input_range is None:
+        phi = np.linspace(0.0, TWO_PI, BRANCH_SWEEP, endpoint=False)
+    else:  # an input that does not turn fully: conditions and change points within its range
+        phi = np.linspace(*mech.input_range, BRANCH_SWEEP)
     poses, _, _ = _input_state(mech, structure, phi, 0)
     plans: list[BranchPlan] = []
     for i, group in enumerate(structure.groups):
@@ -169,9 +173,15 @@ def _choose(mech, group, rule, candidates, poses, phi) -> int:
                  f"(each satisfies it at {votes[1]} of {BRANCH_SWEEP} input angles; give the input "
                  "angle at which it holds with phi_deg)")
         raise SchemeError(
-            f"mechanism '{mech.name}': assembly of point '{rule.point}' ({rule.rule} "
-            f"{list(rule.refs)}) does not tell the two branches of {group!r} apart {where}")
+            f"mechanism '{mech.name}': assembly of point '{rule.point}' ({_describe(rule)}) does not "
+            f"tell the two branches of {group!r} apart {where}")
     return max(votes, key=votes.get)
+
+
+def _describe(rule) -> str:
+    if rule.rule == "towards":
+        return f"from '{rule.refs[0]}' towards {np.degrees(rule.angle):.6g} deg"
+    return f"{rule.rule} {list(rule.refs)}"
 
 
 def _require_assembly(mech, group, poses, branches) -> None:
@@ -254,10 +264,12 @@ def _change_points(mech, structure, plans, i, phi, poses) -> tuple[np.ndarray, n
     before, after = np.roll(low, 1), np.roll(low, -1)
     # local minima of the conditioning, and single angles where the closed form gives up between
     # two assembled neighbours (e.g. the deltoid's coincident pivots)
-    cells = np.flatnonzero(np.roll(ok, 1) & np.roll(ok, -1)
-                           & (~ok | (low <= np.minimum(before, after)))
+    inside = np.roll(ok, 1) & np.roll(ok, -1)
+    if mech.input_range is not None:     # the sweep does not wrap around: no neighbours at its ends
+        inside[[0, -1]] = False
+    cells = np.flatnonzero(inside & (~ok | (low <= np.minimum(before, after)))
                            & (np.minimum(low, np.minimum(before, after)) < 0.1))
-    step = phi[1] - phi[0]
+    step = abs(phi[1] - phi[0])
 
     def measure(x: float) -> float:
         value = group.position(_chain(mech, structure, plans, i, np.array([x])), 1).conditioning[0]

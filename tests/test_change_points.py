@@ -255,3 +255,23 @@ def test_bad_assembly_entries_give_one_message_naming_the_entry(entry, message):
     with pytest.raises(linkage.SchemeError, match=message) as info:
         linkage.loads(four_bar(1, 2, 1, 2, entry).replace('mode = "keep"\n', ""), source="bad.toml")
     assert len(info.value.problems) == 1 and info.value.problems[0].startswith("bad.toml: ")
+
+
+def test_conditions_are_judged_over_the_declared_input_range():
+    """Followed over a turn, 'B left of A -> C' holds for the parallelogram half the time and for
+    its crossed twin the other half (a tie, refused); over the range 10..170 deg it tells them
+    apart."""
+    text = four_bar(1, 2, 1, 2, 'left_of = ["A", "C"]', "follow")
+    with pytest.raises(linkage.SchemeError, match="does not tell the two branches"):
+        linkage.loads(text)
+    ranged = linkage.loads('range_deg = [10.0, 170.0]\n' + text)
+    phi = np.radians(np.linspace(10.0, 170.0, 17))
+    motion, caught = _analyze(ranged, phi)
+    assert caught == []
+    np.testing.assert_allclose(motion.point("B") - motion.point("A"), [[2.0, 0.0]] * len(phi), atol=1e-9)
+
+
+def test_a_towards_condition_that_neither_branch_meets_names_its_angle():
+    text = ISOSCELES.replace('towards_deg = 0\nphi_deg = 45\nmode = "MODE"', 'towards_deg = 90')
+    with pytest.raises(linkage.SchemeError, match="from 'O' towards 90 deg"):
+        linkage.loads(text)
