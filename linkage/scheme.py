@@ -398,32 +398,14 @@ def _add_assembly(builder, point, spec, problems):
     known = {"left_of", "right_of", "towards", "towards_deg", "from", "branch", "mode", "phi", "phi_deg"}
     if unknown_keys(spec, known, where, problems):
         return  # one message: the misspelt key, not the condition it leaves incomplete
-    towards = _angle_key(spec, "towards", where, problems)
-    phi = _angle_key(spec, "phi", where, problems)
-    if towards is _BAD or phi is _BAD:
+    count = len(problems)
+    towards = _angle(spec, "towards", where, problems, default=None)
+    phi = _angle(spec, "phi", where, problems, default=None)
+    if len(problems) > count:
         return
     builder.assembly(point, left_of=spec.get("left_of"), right_of=spec.get("right_of"),
                      towards=towards, origin=spec.get("from"), branch=spec.get("branch"),
                      mode=spec.get("mode", "keep"), phi=phi)
-
-
-_BAD = object()
-
-
-def _angle_key(spec, key, where, problems):
-    """The angle given as ``key`` (rad) or ``key_deg`` (deg), in rad; None when absent, ``_BAD``
-    (with the problem reported) when it is not a number within +-MAX_ANGLE_DEG."""
-    name = f"{key}_deg" if f"{key}_deg" in spec else key
-    if name not in spec:
-        return None
-    raw = spec[name]
-    degrees = raw if name.endswith("_deg") else (math.degrees(raw) if _is_number(raw) else raw)
-    if not (_is_number(raw) and math.isfinite(degrees) and abs(degrees) <= MAX_ANGLE_DEG):
-        unit = "deg" if name.endswith("_deg") else "rad"
-        problems.append(f"{where}: {name} must be a number of {unit} with |x| <= "
-                        f"{MAX_ANGLE_DEG:g} deg, got {raw!r}")
-        return _BAD
-    return math.radians(raw) if name.endswith("_deg") else float(raw)
 
 
 # ----------------------------------------------------------------------------------------------

@@ -248,8 +248,8 @@ def test_a_jump_the_change_point_search_missed_is_still_reported():
 
 @pytest.mark.parametrize("entry, message", [
     ('left_of = ["A", "C"]\nfrom_ = "O"', "assembly.B: unknown keys \\['from_'\\]"),
-    ('left_of = ["A", "C"]\nphi_deg = 1e300', "assembly.B: phi_deg must be a number of deg with \\|x\\| <= 1e\\+06 deg, got 1e\\+300"),
-    ('from = "O"\ntowards_deg = "up"', "assembly.B: towards_deg must be a number of deg"),
+    ('left_of = ["A", "C"]\nphi_deg = 1e300', "assembly.B: 'phi_deg' must be a number with \\|x\\| <= 1e\\+06 deg, got 1e\\+300"),
+    ('from = "O"\ntowards_deg = "up"', "assembly.B: 'towards_deg' must be a number with"),
 ])
 def test_bad_assembly_entries_give_one_message_naming_the_entry(entry, message):
     with pytest.raises(linkage.SchemeError, match=message) as info:
