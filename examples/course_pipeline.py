@@ -33,16 +33,18 @@ try:
     import matplotlib
 
     matplotlib.use("Agg")
-    from linkage.report.plots import plot_columns
+    from linkage.report.plots import draw_mechanism, plot_dynamics
 except ImportError:
     sys.exit(0)
 out = Path(sys.argv[1] if len(sys.argv) > 1 else "out")
 out.mkdir(parents=True, exist_ok=True)
-labels = {"omega": "crank angular velocity ω, rad/s", "balancing_moment": "balancing moment M_b, N·m"}
-for name, label in labels.items():
-    ax = plot_columns(columns, [name])          # phi_deg runs from the start of the cycle
-    ax.set_xlabel("crank angle from the start of the cycle, deg")
-    ax.set_ylabel(label)
-    ax.get_legend().remove()
-    ax.figure.savefig(out / f"course_{name}.png", dpi=100)
+# M_b(phi) with the mean driving moment, omega(phi) and eps(phi); positions 1..13 numbered along the
+# top, the slider's extreme positions marked
+fig = plot_dynamics(report, ["balancing_moment"])
+fig.savefig(out / "course_balancing_moment.png", dpi=150)
+fig = plot_dynamics(report, ["omega", "eps"])
+fig.savefig(out / "course_omega_eps.png", dpi=150)
+motion = linkage.analyze(mech, report.law.phi)
+ax = draw_mechanism(motion, 10, trajectories=["S2"])      # position 11: the working stroke
+ax.figure.savefig(out / "course_mechanism.png", dpi=150)
 print(f"\nplots written to {out}/")

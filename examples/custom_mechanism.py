@@ -52,11 +52,13 @@ try:
     import matplotlib
 
     matplotlib.use("Agg")
-    from linkage.report.plots import draw_mechanism
+    from linkage.report.plots import draw_mechanism, plot_motion
 except ImportError:
     sys.exit(0)
 out = Path(sys.argv[1] if len(sys.argv) > 1 else "out")
 out.mkdir(parents=True, exist_ok=True)
-ax = draw_mechanism(motion, 3)
-ax.figure.savefig(out / "lever_press.png", dpi=100)
-print(f"\npicture written to {out}/lever_press.png")
+ax = draw_mechanism(motion, 3, trajectories=["D"])       # position 4, with the lever tip's arc
+ax.figure.savefig(out / "lever_press.png", dpi=150)
+fig = plot_motion(motion, ["F.x", "F.x'", "F.x''"])      # the slider's position and analogs
+fig.savefig(out / "lever_press_slider.png", dpi=150)
+print(f"\npictures written to {out}/lever_press.png and {out}/lever_press_slider.png")

@@ -48,13 +48,19 @@ def test_custom_mechanism_example_reports_the_lever_stroke(tmp_path):
 
 @pytest.mark.parametrize("name", list(linkage.shipped_schemes()))
 def test_draw_mechanism_puts_every_pair_where_the_analysis_has_it(name):
+    """A revolute pair is a circle at its point, a prismatic pair the slider's block centred there."""
     mech = linkage.load(name)
     motion = linkage.analyze(mech, np.radians([40.0]))
     ax = draw_mechanism(motion, 0)
-    markers = np.array([line.get_xydata()[0] for line in ax.lines if line.get_marker() in ("o", "s")])
+    artists = {p.get_gid(): p for p in ax.patches if p.get_gid()}
     for pair in mech.pairs.values():
         expected = motion.point(pair.point)[0]
-        assert np.min(np.hypot(*(markers - expected).T)) < 1e-12 * mech.size, pair.name
+        if pair.kind == "R":
+            centre = np.asarray(artists[f"pair:{pair.name}"].center)
+        else:
+            block = artists[f"block:{pair.links[1]}"]
+            centre = block.get_xy()[:4].mean(axis=0)
+        assert np.hypot(*(centre - expected)) < 1e-12 * mech.size, pair.name
     matplotlib.pyplot.close(ax.figure)
 
 
