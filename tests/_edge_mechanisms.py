@@ -16,6 +16,8 @@ from typing import Callable
 
 import mpmath as mp
 
+from _texts import four_bar_toml, slider_crank_toml
+
 mp.mp.dps = 50
 
 
@@ -57,31 +59,7 @@ def reference(case: EdgeCase, phi: float) -> dict[str, tuple[float, float, float
 # ----------------------------------------------------------------------------------------------
 # RRR: the issue's non-Grashof four-bar (crank 1, coupler 1.2, rocker 1, ground 2)
 # ----------------------------------------------------------------------------------------------
-RRR_TOML = """
-name = "rrr_edge"
-input = "1"
-[links.0]
-points = { O = [0.0, 0.0], C = [2.0, 0.0] }
-[links.1]
-line = ["O", "A"]
-length = 1.0
-[links.2]
-line = ["A", "B"]
-length = 1.2
-[links.3]
-line = ["C", "B"]
-length = 1.0
-[pairs.O]
-links = ["0", "1"]
-[pairs.A]
-links = ["1", "2"]
-[pairs.B]
-links = ["2", "3"]
-[pairs.C]
-links = ["3", "0"]
-[assembly.B]
-left_of = ["A", "C"]
-"""
+RRR_TOML = four_bar_toml(1.0, 1.2, 1.0, 2.0, name="rrr_edge")
 
 
 def _rrr(phi):
@@ -101,35 +79,7 @@ def _rrr(phi):
 # ----------------------------------------------------------------------------------------------
 # RRP: slider-crank whose rod (0.6) is shorter than the crank (1): toggle at sin(phi) = 0.6
 # ----------------------------------------------------------------------------------------------
-RRP_TOML = """
-name = "rrp_edge"
-input = "1"
-[links.0]
-points = { O = [0.0, 0.0] }
-guides.slide = { through = [0.0, 0.0], angle_deg = 0 }
-[links.1]
-line = ["O", "A"]
-length = 1.0
-[links.2]
-line = ["A", "B"]
-length = 0.6
-[links.3]
-points.B = [0.0, 0.0]
-[pairs.O]
-links = ["0", "1"]
-[pairs.A]
-links = ["1", "2"]
-[pairs.B]
-links = ["2", "3"]
-[pairs.slide]
-kind = "P"
-links = ["0", "3"]
-guide = "slide"
-at = "B"
-[assembly.B]
-from = "A"
-towards_deg = 0
-"""
+RRP_TOML = slider_crank_toml(1.0, 0.6, name="rrp_edge")
 
 
 def _rrp(phi):

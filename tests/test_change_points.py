@@ -15,67 +15,19 @@ import linkage
 from linkage.assembly import assembly_plans
 from linkage.kinematics import BranchWarning
 
+from _texts import four_bar_toml, slider_crank_toml
+
 
 def four_bar(crank, coupler, rocker, ground, condition, mode="keep"):
-    return f"""
-name = "four_bar_{crank}_{coupler}_{rocker}_{ground}"
-input = "1"
-[links.0]
-points = {{ O = [0.0, 0.0], C = [{ground}, 0.0] }}
-[links.1]
-line = ["O", "A"]
-length = {crank}
-[links.2]
-line = ["A", "B"]
-length = {coupler}
-[links.3]
-line = ["C", "B"]
-length = {rocker}
-[pairs.O]
-links = ["0", "1"]
-[pairs.A]
-links = ["1", "2"]
-[pairs.B]
-links = ["2", "3"]
-[pairs.C]
-links = ["3", "0"]
-[assembly.B]
-{condition}
-mode = "{mode}"
-"""
+    return four_bar_toml(crank, coupler, rocker, ground, f'{condition}\nmode = "{mode}"',
+                         name=f"four_bar_{crank}_{coupler}_{rocker}_{ground}")
 
 
-ISOSCELES = """
-name = "isosceles_slider_crank"
-input = "1"
-[links.0]
-points = { O = [0.0, 0.0] }
-guides.slide = { through = [0.0, 0.0], angle_deg = 0 }
-[links.1]
-line = ["O", "A"]
-length = 1.0
-[links.2]
-line = ["A", "B"]
-length = 1.0
-[links.3]
-points.B = [0.0, 0.0]
-[pairs.O]
-links = ["0", "1"]
-[pairs.A]
-links = ["1", "2"]
-[pairs.B]
-links = ["2", "3"]
-[pairs.slide]
-kind = "P"
-links = ["0", "3"]
-guide = "slide"
-at = "B"
-[assembly.B]
-from = "O"
-towards_deg = 0
-phi_deg = 45
-mode = "MODE"
-"""
+def isosceles(mode=None, condition='from = "O"\ntowards_deg = 0\nphi_deg = 45'):
+    """Slider-crank with rod = crank = 1: at +-90 deg the slider may follow the crank or rest at O."""
+    return slider_crank_toml(1.0, 1.0, condition + (f'\nmode = "{mode}"' if mode else ""),
+                             name="isosceles_slider_crank")
+
 
 TURN = np.radians(np.arange(2.5, 360.0, 5.0))          # a table over one turn, off the change points
 
@@ -165,7 +117,7 @@ def test_deltoid_followed_over_a_whole_turn_says_it_repeats_after_two_turns():
 
 
 def test_isosceles_slider_crank_followed_keeps_following_the_crank():
-    mech = linkage.loads(ISOSCELES.replace("MODE", "follow"))
+    mech = linkage.loads(isosceles("follow"))
     motion, caught = _analyze(mech, TURN)
     assert caught == []
     np.testing.assert_allclose(motion.point("B")[:, 0], 2 * np.cos(TURN), atol=1e-9)
@@ -173,7 +125,7 @@ def test_isosceles_slider_crank_followed_keeps_following_the_crank():
 
 
 def test_isosceles_slider_crank_kept_rests_at_the_pivot_half_the_turn_with_a_warning():
-    mech = linkage.loads(ISOSCELES.replace("MODE", "keep"))
+    mech = linkage.loads(isosceles("keep"))
     motion, caught = _analyze(mech, TURN)
     assert len(caught) == 1 and "90" in caught[0] and "270" in caught[0]
     right = np.cos(TURN) > 0
@@ -272,6 +224,6 @@ def test_conditions_are_judged_over_the_declared_input_range():
 
 
 def test_a_towards_condition_that_neither_branch_meets_names_its_angle():
-    text = ISOSCELES.replace('towards_deg = 0\nphi_deg = 45\nmode = "MODE"', 'towards_deg = 90')
+    text = isosceles(condition='from = "O"\ntowards_deg = 90')
     with pytest.raises(linkage.SchemeError, match="from 'O' towards 90 deg"):
         linkage.loads(text)

@@ -25,6 +25,7 @@ from scipy.optimize import brentq
 import linkage
 
 from _cli_io import read_csv, read_table, run
+from _texts import four_bar_toml
 
 ROOT = Path(__file__).resolve().parents[1]
 SHIPPED = list(linkage.shipped_schemes())
@@ -417,36 +418,12 @@ def test_ode_notes_a_steady_speed_far_from_the_declared_one(capsys, tmp_path):
     assert "delta = 0.08" in note[0]
 
 
-LONG_CRANK = """
-name = "long_crank"
-input = "1"
-[links.0]
-points = { O = [0.0, 0.0], C = [0.3, 0.0] }
-[links.1]
-line = ["O", "A"]
-length = 0.3
-[links.2]
-line = ["A", "B"]
-length = 0.3
-[links.3]
-line = ["C", "B"]
-length = 0.25
-[pairs.O]
-links = ["0", "1"]
-[pairs.A]
-links = ["1", "2"]
-[pairs.B]
-links = ["2", "3"]
-[pairs.C]
-links = ["3", "0"]
-[assembly.B]
-left_of = ["A", "C"]
-[dynamics]
+LONG_CRANK = four_bar_toml(0.3, 0.3, 0.25, 0.3, name="long_crank", tail="""[dynamics]
 mean_speed = 1.0
 delta = 0.1
 start_deg = 0
 inertia_0 = 1.0
-"""
+""")
 
 
 def test_cli_errors_speak_in_cli_terms(capsys, tmp_path):

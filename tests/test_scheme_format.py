@@ -39,6 +39,7 @@ from linkage.reduced import reduced_characteristics
 from linkage.scheme import from_dict, to_dict
 
 from _cli_io import read_csv, run
+from _texts import slider_crank_toml
 
 README = Path(__file__).resolve().parent.parent / "schemes" / "README.md"
 
@@ -335,40 +336,8 @@ def test_between_points_that_coincide_is_refused():
 # ----------------------------------------------------------------------------------------------
 
 RL1, RL2 = 0.2, 0.1  # rocker slider-crank: the crank is longer than the rod, |sin phi| <= 1/2
-ROCKER = """
-name = "rocker_slider"
-input = "1"
-output = { quantity = "B.x", start = "max" }
-range_deg = [-20, 25]
-
-[links.0]
-points = { O = [0.0, 0.0] }
-guides.slide = { through = [0.0, 0.0], angle_deg = 0 }
-[links.1]
-line = ["O", "A"]
-length = 0.2
-[links.2]
-line = ["A", "B"]
-length = 0.1
-[links.3]
-points.B = [0.0, 0.0]
-
-[pairs.O]
-links = ["0", "1"]
-[pairs.A]
-links = ["1", "2"]
-[pairs.B]
-links = ["2", "3"]
-[pairs.slide]
-kind = "P"
-links = ["0", "3"]
-guide = "slide"
-at = "B"
-
-[assembly.B]
-from = "A"
-towards_deg = 0
-"""
+ROCKER = slider_crank_toml(RL1, RL2, name="rocker_slider", header='output = { quantity = "B.x", start = "max" }\n'
+                           'range_deg = [-20, 25]')
 
 
 def x_rocker(phi):
