@@ -43,7 +43,6 @@ The full format (every key, unit and default) is in ``schemes/README.md``.
 
 from __future__ import annotations
 
-import warnings
 from dataclasses import dataclass, field
 from typing import Any, Mapping, Sequence
 
@@ -474,8 +473,6 @@ def _entries(raw: Mapping[str, Any], key: str, problems: list[str]) -> list:
 #: keys of a ``[[loads.forces]]`` entry
 FORCE_KEYS = {"point", "link", "force", "diagram", "cycle", "along", "magnitude", "between", "along_link",
               "angle", "angle_deg"}
-#: input angles at which the two points of a ``between`` direction are checked not to coincide
-DIRECTION_SWEEP = 360
 
 
 def _direction(mech: Mechanism, spec: Mapping[str, Any], where: str, problems: list[str]):
@@ -531,13 +528,10 @@ def _direction(mech: Mechanism, spec: Mapping[str, Any], where: str, problems: l
 def _coincide(mech: Mechanism, direction: Direction) -> str | None:
     """Why the line through the two points of ``direction`` is undefined (they coincide at some
     input angle of the turn or range), or None."""
-    from .kinematics import analyze
+    from .kinematics import input_sweep
 
-    lo, hi = mech.input_range if mech.input_range is not None else (0.0, 2 * np.pi)
-    phi = np.linspace(lo, hi, DIRECTION_SWEEP + 1)
-    with warnings.catch_warnings():  # mode changes are the analysis's to report, not the load's
-        warnings.simplefilter("ignore")
-        motion = analyze(mech, phi, order=0, on_failure="mask")
+    motion = input_sweep(mech)
+    phi = motion.phi
     p, q = (motion.point(name) for name in direction.between)
     gap = np.hypot(*(q - p).T)
     close = np.flatnonzero(np.isfinite(gap) & (gap <= 1e-9 * mech.size))

@@ -28,8 +28,12 @@ from .errors import AssemblyError, InputError, StructureError
 from .model import Mechanism, Prismatic
 from .structure import Structure, decompose
 
-__all__ = ["Motion", "analyze", "structure_of", "assembly_branches", "BranchWarning", "parse_quantity",
+__all__ = ["Motion", "analyze", "input_sweep", "SWEEP", "structure_of", "assembly_branches", "BranchWarning", "parse_quantity",
            "table_positions_deg", "angle_in_half_turn"]
+
+
+#: input angles of :func:`input_sweep` (a turn in 360 steps, both ends included, or the input range)
+SWEEP = 361
 
 
 class BranchWarning(UserWarning):
@@ -181,7 +185,7 @@ class Motion:
             their first step); for a single angle the sign of a nonzero ``omega``, else +1.
         """
         mech = self.mechanism
-        direction = self._direction() if direction is None else direction
+        direction = self.direction if direction is None else direction
         if direction not in (1, -1):
             raise InputError(f"direction must be +1 or -1, got {direction!r}")
         cols: dict[str, np.ndarray] = {"i": np.arange(1, len(self.phi) + 1),
@@ -203,7 +207,8 @@ class Motion:
                     cols[q + prime] = angle_in_half_turn(arr) if q.endswith(".theta") and not prime else arr
         return cols
 
-    def _direction(self) -> int:
+    @property
+    def direction(self) -> int:
         """The sense of the table: of the first step between the angles; for a single angle the
         sign of a nonzero omega; else +1."""
         sense = _sense(self.phi)
@@ -354,6 +359,20 @@ def analyze(
     return Motion(mech, structure, phi, poses, first if order >= 1 else None,
                   second if order >= 2 else None, status, omega_arr, eps_arr, conditioning,
                   np.max(list(error.values()), axis=0))
+
+
+def input_sweep(mech: Mechanism) -> Motion:
+    """Positions (order 0, per-position status) over the input's whole travel: a turn at
+    :data:`SWEEP` angles from 0 to 2 pi, or the declared input range; computed once per mechanism
+    (load-time checks and drawings share it). Mode changes are left for the analyses that pass
+    them to report."""
+    cache = _cache(mech)
+    if "sweep" not in cache:
+        low, high = mech.input_range if mech.input_range is not None else (0.0, 2 * np.pi)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", BranchWarning)
+            cache["sweep"] = analyze(mech, np.linspace(low, high, SWEEP), order=0, on_failure="mask")
+    return cache["sweep"]
 
 
 def _links_of(mech: Mechanism, outputs: Iterable[str]) -> list[str]:

@@ -98,7 +98,7 @@ class Reactions:
         from +x in (-180, 180]); with ``full`` also ``K.Rx``, ``K.Ry`` (N) and, for
         prismatic pairs, ``K.M`` (N m, the moment of the slider on the guide about the slider's
         point). Pairs in the order of their names. ``direction``: see :meth:`Motion.columns`."""
-        direction = self.motion._direction() if direction is None else direction
+        direction = self.motion.direction if direction is None else direction
         cols = {"i": np.arange(1, len(self.motion.phi) + 1),
                 "phi_deg": table_positions_deg(self.motion.phi, direction),
                 "balancing_moment": self.balancing_moment}

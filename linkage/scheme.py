@@ -15,7 +15,6 @@ import importlib.resources
 import math
 import re
 import tomllib
-import warnings
 from pathlib import Path
 from typing import Any, Callable, Mapping
 
@@ -267,10 +266,6 @@ def from_dict(data: Mapping[str, Any], default_name: str = "mechanism") -> Mecha
     return mech
 
 
-#: input angles at which a declared input range is checked to assemble (ends included)
-RANGE_SWEEP = 361
-
-
 def _input_range(data: Mapping[str, Any], problems: list[str]) -> tuple[float, float] | None:
     """The input range ``range_deg = [a, b]`` (or ``range``, rad) in rad; None when absent or
     refused (with the problem, naming the key and the value)."""
@@ -303,13 +298,10 @@ def _check_range_assembles(mech: Mechanism, data: Mapping[str, Any]) -> None:
 
     from assur.base import CANNOT_ASSEMBLE
 
-    from .kinematics import analyze
+    from .kinematics import input_sweep
 
-    a, b = mech.input_range
-    phi = np.linspace(a, b, RANGE_SWEEP)
-    with warnings.catch_warnings():  # mode changes are the analysis's to report, not the range's
-        warnings.simplefilter("ignore")
-        motion = analyze(mech, phi, order=0, on_failure="mask")
+    motion = input_sweep(mech)
+    phi = motion.phi
     bad = np.flatnonzero(motion.status == CANNOT_ASSEMBLE)
     if not len(bad):
         return
@@ -319,7 +311,7 @@ def _check_range_assembles(mech: Mechanism, data: Mapping[str, Any]) -> None:
     runs = _runs(deg, bad)
     assembles = f"; it assembles at {_runs(deg, ok)} deg" if len(ok) else "; it assembles nowhere in it"
     raise SchemeError(f"{key} = {data[key]!r}: the mechanism cannot be assembled at phi = {runs} deg of "
-                      f"this range{assembles} (checked at {RANGE_SWEEP} angles): declare a range within "
+                      f"this range{assembles} (checked at {len(phi)} angles): declare a range within "
                       "which it assembles")
 
 

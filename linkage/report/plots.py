@@ -50,6 +50,7 @@ import numpy as np
 from assur.base import global_point
 
 from ..errors import InputError, LinkageError
+from ..kinematics import input_sweep
 from ..model import Mechanism, Prismatic
 from .tables import column_unit
 
@@ -686,7 +687,7 @@ def plot_motion(motion, names: Sequence[str], *, extremes: bool | str = True, po
     _pyplot()
     mech = motion.mechanism
     columns = motion.columns()
-    direction = motion._direction()
+    direction = motion.direction
     order = 2 if motion.second is not None else 1 if motion.first is not None else 0
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -791,23 +792,6 @@ class _Scene:
     trajectories: list[tuple[str, str, np.ndarray]] = field(default_factory=list)  # (point, link, (M, 2))
 
 
-def _sweep(mech: Mechanism, samples: int = 361):
-    """Positions over a whole turn (or the input range), for guide lengths and trajectories."""
-    from ..kinematics import _cache, analyze
-
-    cache = _cache(mech)
-    key = ("plots.sweep", samples)
-    if key not in cache:
-        if mech.input_range is not None:
-            grid = np.linspace(*mech.input_range, samples)
-        else:
-            grid = np.linspace(0.0, 2 * np.pi, samples)
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            cache[key] = analyze(mech, grid, order=0, on_failure="mask")
-    return cache[key]
-
-
 def _global(motion, link: str, local, rows) -> np.ndarray:
     return global_point(motion.poses[link][rows], local)
 
@@ -855,7 +839,7 @@ class _Geometry:
     def __init__(self, motion, positions: Sequence[int], trajectories: Sequence[str] = ()):
         self.motion = motion
         self.mech = mech = motion.mechanism
-        self.sweep = _sweep(mech)
+        self.sweep = input_sweep(mech)
         self.trajectories = list(trajectories)
         for name in self.trajectories:
             if name not in mech.point_names:
@@ -1115,7 +1099,7 @@ def _caption(motion, i: int, trajectories: Sequence[str] = (), compact: bool = F
     from ..kinematics import table_positions_deg
 
     mech = motion.mechanism
-    direction = motion._direction()
+    direction = motion.direction
     turned = float(table_positions_deg(motion.phi, direction)[i])
     sense = "counter-clockwise" if direction > 0 else "clockwise"
     absolute = float(np.mod(np.degrees(motion.phi[i]), 360.0))
