@@ -5,12 +5,14 @@ import subprocess
 import sys
 from pathlib import Path
 
-import matplotlib
 import numpy as np
 import pytest
 
-import linkage
-from linkage.report.plots import draw_mechanism, plot_columns
+matplotlib = pytest.importorskip(
+    "matplotlib", reason="pictures need the plot extra, which the test extra installs: pip install \".[test]\"")
+
+import linkage  # noqa: E402 (after the skip when matplotlib is missing)
+from linkage.report.plots import draw_mechanism, plot_columns  # noqa: E402
 
 matplotlib.use("Agg")
 

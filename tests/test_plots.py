@@ -5,9 +5,11 @@ import io
 import re
 import sys
 
-import matplotlib
 import numpy as np
 import pytest
+
+matplotlib = pytest.importorskip(
+    "matplotlib", reason="pictures need the plot extra, which the test extra installs: pip install \".[test]\"")
 
 matplotlib.use("Agg")
 
