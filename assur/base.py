@@ -365,6 +365,14 @@ class Group(ABC):
                 points.append(global_point(poses[j.b], j.p))
         return np.stack(points, axis=1)
 
+    def scale(self, poses: Poses, contacts: np.ndarray | None = None) -> np.ndarray:
+        """The group's own length scale ``(N,)``, m: the largest distance between the points where
+        its pairs act (at least the round-off of their coordinates; 1 where they all coincide)."""
+        contacts = self.contact_points(poses) if contacts is None else contacts
+        spread = np.linalg.norm(contacts[:, :, None, :] - contacts[:, None, :, :], axis=-1)
+        scale = np.maximum(np.max(spread, axis=(1, 2)), 1e-12 * np.max(np.abs(contacts), axis=(1, 2)))
+        return np.where(scale > 0, scale, 1.0)
+
     def conditioning(self, phi_q: np.ndarray, poses: Poses) -> tuple[np.ndarray, np.ndarray]:
         """Scale-free conditioning of the group Jacobian and the sign of its determinant.
 
@@ -393,11 +401,7 @@ class Group(ABC):
             Sign of ``det(phi_q)``.
         """
         contacts = self.contact_points(poses)                          # (N, J, 2)
-        spread = np.linalg.norm(contacts[:, :, None, :] - contacts[:, None, :, :], axis=-1)
-        scale = np.max(spread, axis=(1, 2))
-        floor = 1e-12 * np.max(np.abs(contacts), axis=(1, 2))       # round-off of the coordinates
-        scale = np.maximum(scale, floor)
-        scale = np.where(scale > 0, scale, 1.0)[:, None, None]
+        scale = self.scale(poses, contacts)[:, None, None]
         scaled = phi_q.copy()
         for i, link in enumerate(self.links):
             mine = [r for r, j in enumerate(self.joints) if link in (j.a, j.b)]

@@ -75,6 +75,14 @@ class BranchPlan:
         count = turns.astype(int) * len(points) + np.searchsorted(points, phi - turns * TWO_PI, side="right")
         return np.where(count % 2 == 0, self.branch, -self.branch)
 
+    def crossed(self, phi: np.ndarray) -> np.ndarray:
+        """``(K, N-1)`` bool: whether the step between consecutive angles ``phi`` (rad, unwrapped)
+        passes each change point (or one of its copies a whole number of turns away)."""
+        phi = np.asarray(phi, dtype=float)
+        low, high = np.minimum(phi[:-1], phi[1:]), np.maximum(phi[:-1], phi[1:])
+        points = self.change_points[:, None]
+        return np.floor((high - points) / TWO_PI) > np.floor((low - points) / TWO_PI)
+
     @property
     def closes(self) -> bool:
         """Whether the followed motion repeats after one turn (an even number of swaps)."""
@@ -136,13 +144,15 @@ def assembly_plans(mech: Mechanism) -> tuple[BranchPlan, ...]:
     for i, group in enumerate(structure.groups):
         rule = rules.get(i)
         mode = rule.mode if rule is not None else "keep"
+        # the first branch's placement: both branches of a closed form assemble at the same angles
+        first = group.position(poses, group.branches[0])
+        if np.all(first.status == -1):
+            _never_assembles(mech, group, poses)
         if len(group.branches) == 1:
             plan = BranchPlan(1, "keep", np.empty(0), np.empty(0, bool))
-            _require_assembly(mech, group, poses, plan.branches(phi))
         else:
-            changes, swaps = _change_points(mech, structure, plans, i, phi, poses)
+            changes, swaps = _change_points(mech, structure, plans, i, phi, first.conditioning)
             candidates = {m: BranchPlan(m, mode, changes, swaps) for m in group.branches}
-            _require_assembly(mech, group, poses, candidates[1].branches(phi))
             if rule is not None and rule.phi is not None:
                 at = np.array([rule.phi])
                 chosen = _choose(mech, group, rule, candidates, _chain(mech, structure, plans, i, at), at)
@@ -184,11 +194,8 @@ def _describe(rule) -> str:
     return f"{rule.rule} {list(rule.refs)}"
 
 
-def _require_assembly(mech, group, poses, branches) -> None:
-    """SchemeError naming the group and the reason when it assembles at no angle of the sweep."""
-    placed = place_group(group, poses, branches)
-    if np.any(placed.status != -1):
-        return
+def _never_assembles(mech, group, poses) -> None:
+    """SchemeError naming the group, which assembles at no angle of the sweep, and the reason."""
     reason = group.assembly_failure(poses)
     raise SchemeError(
         f"mechanism '{mech.name}': group {group!r} cannot be assembled at any input angle"
@@ -254,11 +261,10 @@ def _chain(mech, structure, plans, i, phi):
     return poses
 
 
-def _change_points(mech, structure, plans, i, phi, poses) -> tuple[np.ndarray, np.ndarray]:
-    """Angles in [0, 2 pi) where group ``i``'s assembly modes meet, and whether the motion swaps
-    closed-form branch there."""
+def _change_points(mech, structure, plans, i, phi, r) -> tuple[np.ndarray, np.ndarray]:
+    """Angles in [0, 2 pi) where group ``i``'s assembly modes meet (from its conditioning ``r``
+    over the sweep ``phi``), and whether the motion swaps closed-form branch there."""
     group = structure.groups[i]
-    r = group.position(poses, 1).conditioning
     ok = np.isfinite(r)
     low = np.where(ok, r, np.inf)
     before, after = np.roll(low, 1), np.roll(low, -1)
@@ -312,7 +318,7 @@ def _swaps(mech, structure, plans, i, angle) -> bool | None:
             return None
         merged = {**poses, **placed.poses}
         contacts = group.contact_points(merged)                      # (6, J, 2)
-        scale = np.max(np.linalg.norm(contacts - contacts.mean(axis=1, keepdims=True), axis=-1)) or 1.0
+        scale = float(np.max(group.scale(merged, contacts)))
         parts = [contacts.reshape(6, -1)]
         for link in group.links:
             theta = merged[link][:, 2]

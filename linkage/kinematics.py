@@ -447,10 +447,8 @@ def _check_change_points(group, plan, phi) -> None:
     if len(phi) < 2 or not len(plan.change_points):
         return
     if plan.mode == "keep":
-        lo, hi = np.minimum(phi[:-1], phi[1:]), np.maximum(phi[:-1], phi[1:])
-        passed = [c for c in plan.change_points
-                  if np.any(np.floor((hi - c) / (2 * np.pi)) > np.floor((lo - c) / (2 * np.pi)))]
-        if passed:
+        passed = plan.change_points[plan.crossed(phi).any(axis=1)]
+        if len(passed):
             shown = ", ".join(f"{round(float(np.degrees(c)), 6) % 360 + 0.0:g}" for c in passed)
             warnings.warn(
                 f"group {group!r} passes a change point at input angle(s) {shown} deg, where its two "
@@ -477,14 +475,11 @@ def _check_jumps(group, plan, poses, first, status, phi) -> None:
         return
     dphi = np.diff(phi)
     pairs = (status[:-1] == OK) & (status[1:] == OK) & (np.abs(dphi) <= JUMP_CHECK_STEP) & (dphi != 0)
-    for c in plan.change_points if plan.mode == "keep" else ():      # already reported
-        lo, hi = np.minimum(phi[:-1], phi[1:]), np.maximum(phi[:-1], phi[1:])
-        pairs &= ~(np.floor((hi - c) / (2 * np.pi)) > np.floor((lo - c) / (2 * np.pi)))
+    if plan.mode == "keep" and len(plan.change_points):        # passed change points: reported
+        pairs &= ~plan.crossed(phi).any(axis=0)
     if not pairs.any():
         return
-    contacts = group.contact_points(poses)
-    scale = float(np.nanmedian(np.max(np.linalg.norm(contacts - contacts.mean(axis=1, keepdims=True),
-                                                     axis=-1), axis=1))) or group.size
+    scale = float(np.nanmedian(group.scale(poses)))
     moved, allowed = [], []
     for link in group.links:
         origin = np.zeros(2)
