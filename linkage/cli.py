@@ -43,6 +43,7 @@ from .kinematics import analyze, structure_of, table_positions_deg
 from .motors import RPM
 from .model import MAX_ANGLE_DEG, MAX_MAGNITUDE, MAX_POSITIONS
 from .report import FORMATS, format_columns
+from .report.results import JSON_CONVENTIONS
 from .report.tables import select_columns, table_width, units_of
 from .scheme import load, section_of, shipped_schemes
 
@@ -332,7 +333,7 @@ def _emit(columns: dict, args, meta: dict, default_view: Callable[[dict], list[s
                                        "(or --format csv / json)"}
         columns = {name: columns[name] for name in shown}
     if args.format == "json":
-        meta = {**meta, "conventions": "see `linkage --help` and docs/conventions.md"}
+        meta = {**meta, "conventions": JSON_CONVENTIONS}
     _out(format_columns(columns, args.format, meta=meta, units=units))
 
 
@@ -662,7 +663,8 @@ def _dynamics_view(columns: dict) -> list[str]:
 
 
 def _cmd_dynamics(args: argparse.Namespace) -> int:
-    from .dynamics import _override, run_dynamics, simulate
+    from .dynamics import _override, simulate
+    from .report.results import dynamics_results
 
     mech = load(args.scheme)
     if args.transient and args.method != "ode":
@@ -680,8 +682,9 @@ def _cmd_dynamics(args: argparse.Namespace) -> int:
         then = " and integrating the start-up transient" if spec.initial_speed is not None else ""
         _note("note", f"{first}shooting for the motor-driven steady state{then}; this takes a few seconds")
     with _options_named(args):
-        report = run_dynamics(mech, args.method, positions=args.positions, delta=args.delta,
-                              mean_speed=_speed(args))
+        results = dynamics_results(mech, args.method, positions=args.positions, delta=args.delta,
+                                   mean_speed=_speed(args))
+    report, summary = results.report, dict(results.summary)
     for note in report.notes:
         _note("note", note)
     if spec is not None:
@@ -689,8 +692,6 @@ def _cmd_dynamics(args: argparse.Namespace) -> int:
     law = report.law
     direction = law.reduced.rotation
     n = len(law.phi) - 1
-    summary = {"scheme": mech.name, "positions": n, "phi0_deg": float(np.degrees(law.phi[0])),
-               "direction": direction, **report.summary()}
     if args.transient:
         transient = simulate(mech, spec, constant_inertia=law.constant_inertia)
         columns = transient.columns()
@@ -700,7 +701,7 @@ def _cmd_dynamics(args: argparse.Namespace) -> int:
                  f"{_sense_in_words(direction)}, 360 per cycle, {spec.cycles} cycles")
         always = ("t", "phi_deg")
     else:
-        columns = report.columns()
+        columns = results.columns
         start = _start_line(mech, law.phi, declared.start if declared is not None else "extreme", n, direction)
         always = ("i", "phi_deg")
     if args.format == "table":

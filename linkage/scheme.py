@@ -455,7 +455,13 @@ def to_dict(mech: Mechanism) -> dict[str, Any]:
 
 def dumps(mech: Mechanism) -> str:
     """TOML text of a mechanism that :func:`loads` reads back to an equal mechanism."""
-    return _toml_table(to_dict(mech), ())
+    return toml_text(to_dict(mech))
+
+
+def toml_text(data: Mapping[str, Any]) -> str:
+    """TOML text of plain data (tables, arrays of tables, numbers, strings, lists) that
+    ``tomllib.loads`` reads back equal; floats are written with ``repr`` (exact)."""
+    return _toml_table(data, ())
 
 
 def save(mech: Mechanism, path: str | Path) -> None:
