@@ -196,6 +196,10 @@ def from_dict(data: Mapping[str, Any], default_name: str = "mechanism") -> Mecha
     """
     from .kinematics import assembly_branches, structure_of
 
+    if "template" in data:
+        raise SchemeError("this is an assignment template (it has a [template] table, and its values are "
+                          "expressions of parameters), not a scheme: make variants of it with `linkage variants` "
+                          "or linkage.template.load_template (docs/templates.md)")
     problems: list[str] = []
     extra_sections = {k: v for k, v in data.items() if k in SECTION_PARSERS}
     name = data.get("name", default_name)
