@@ -38,12 +38,12 @@ import numpy as np
 
 from . import __version__
 from .errors import InputError, LinkageError, SchemeError
-from .extremes import table_angles
-from .kinematics import analyze, structure_of, table_positions_deg
+from .kinematics import structure_of
 from .motors import RPM
 from .model import MAX_ANGLE_DEG, MAX_MAGNITUDE, MAX_POSITIONS
 from .report import FORMATS, format_columns
-from .report.results import JSON_CONVENTIONS
+from .report.results import (JSON_CONVENTIONS, NUMERICAL_WARNING, InputRange, declared_rotation, forces_results,
+                             kinematics_results)
 from .report.tables import select_columns, table_width, units_of
 from .scheme import load, section_of, shipped_schemes
 
@@ -86,12 +86,6 @@ table conventions (docs/conventions.md):
 def _declared_dynamics(mech):
     """The scheme's dynamics inputs (parsed once, with the scheme), or None."""
     return section_of(mech, "dynamics")
-
-
-def _rotation(mech) -> int:
-    """Order of table positions: the sign of the scheme's declared mean speed, else +1."""
-    spec = _declared_dynamics(mech)
-    return spec.rotation if spec is not None else 1
 
 
 # ----------------------------------------------------------------------------------------------
@@ -239,20 +233,6 @@ def _add_scheme_argument(p: argparse.ArgumentParser) -> None:
                    help="a shipped scheme name (see 'linkage schemes') or the path of a .toml file")
 
 
-class InputRange:
-    """``--range A B``: the table runs over the input angles A..B (deg) instead of a turn."""
-
-    def __init__(self, a: float, b: float):
-        self.a, self.b = a, b
-
-    @property
-    def span(self) -> tuple[float, float]:
-        return math.radians(self.a), math.radians(self.b)
-
-    def __repr__(self) -> str:
-        return f"--range {self.a:g} {self.b:g}"
-
-
 class _RangeAction(argparse.Action):
     """Parse ``--range A B`` into an :class:`InputRange` kept as the table's start (``args.start``):
     the range fixes position 1 at A, so it excludes ``--start``."""
@@ -304,15 +284,6 @@ def _add_columns_argument(p: argparse.ArgumentParser) -> None:
                         "shell-style patterns separated by commas, e.g. 'B.*,3.theta'; '*' gives "
                         "them all (default: the table for people shows the columns that matter, "
                         "CSV and JSON every column)")
-
-
-def _scheme_defaults(mech, args) -> tuple[int, str | float]:
-    """The number of positions and the start of the table: the options, else the scheme's
-    [dynamics] positions and start_deg, else 12 positions from the output's extreme position."""
-    spec = _declared_dynamics(mech)
-    n = args.positions if args.positions is not None else spec.positions if spec is not None else 12
-    start = args.start if args.start is not None else spec.start if spec is not None else "extreme"
-    return n, start
 
 
 def _emit(columns: dict, args, meta: dict, default_view: Callable[[dict], list[str]] | None = None,
@@ -410,12 +381,6 @@ def _analyze_view(mech):
     return view
 
 
-def _table_sense(phi: np.ndarray) -> int:
-    """+1 / -1: the sense in which the table's input angles run (the ``direction`` that
-    ``phi = phi0 + direction * phi_deg`` holds with)."""
-    return -1 if len(phi) > 1 and phi[-1] < phi[0] else 1
-
-
 def _sense_in_words(direction: int) -> str:
     return "counter-clockwise" if direction > 0 else "clockwise"
 
@@ -438,84 +403,25 @@ def _start_line(mech, phi: np.ndarray, start, n: int, direction: int | None = No
             f"{n} steps per revolution")
 
 
-def _table_positions(mech, n: int, start: str | float, direction: int) -> tuple[np.ndarray, str | float]:
-    """Input angles of the table (rad) and the start actually used ("range" over an input range:
-    ``--range A B``, else the scheme's range_deg)."""
-    if isinstance(start, InputRange) or mech.input_range is not None:
-        if not (start is None or start == "extreme" or isinstance(start, InputRange)):
-            a, b = np.degrees(mech.input_range)
-            raise InputError(f"scheme '{mech.name}' declares range_deg = [{a:.10g}, {b:.10g}], which fixes "
-                             f"position 1 at {a:.10g} deg: --start {start} applies to a full turn (choose "
-                             "another range with --range A B)")
-        span = start.span if isinstance(start, InputRange) else None
-        return table_angles(mech, n, "extreme", direction, span=span), "range"
-    if isinstance(start, str) and mech.output is None:
-        _note("note", f"scheme '{mech.name}' declares no output, so it has no extreme position: "
-                      "the table starts at phi = 0 deg (use --start DEG to choose)")
-        start = 0.0
-    try:
-        return table_angles(mech, n, start, direction), start
-    except InputError as exc:  # e.g. the output has no extreme position
-        if isinstance(start, str):
-            raise InputError(f"{exc} (choose position 1 with --start DEG)") from None
-        raise
-
-
 def _cmd_analyze(args: argparse.Namespace) -> int:
     mech = load(args.scheme)
-    direction = _rotation(mech)
-    n, start = _scheme_defaults(mech, args)
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        phi, start = _table_positions(mech, n, start, direction)
-        motion = analyze(mech, phi, order=2, on_failure="mask")
-        columns = motion.columns()
-    failed = _report_failures(motion)
-    for w in caught:
-        if issubclass(w.category, RuntimeWarning) and failed:
-            continue  # numerical noise at the masked positions, reported above
-        _note("warning", str(w.message))
-    meta = {
-        "scheme": mech.name,
-        "description": mech.description,
-        "formula": structure_of(mech).formula,
-        "positions": n,
-        "start": start,
-        "phi0_deg": float(np.degrees(phi[0])),
-        "direction": _table_sense(phi),
-        "failed": failed,
-    }
+    results = kinematics_results(mech, args.positions, args.start)
+    _say(results)
+    meta = results.meta
     if args.format == "table":
+        phi = results.motion.phi
         meta = {"scheme": mech.name, "formula": meta["formula"],
-                "start": _start_line(mech, phi, start, n, direction)}
-    _emit(columns, args, meta, _analyze_view(mech))
+                "start": _start_line(mech, phi, meta["start"], meta["positions"], declared_rotation(mech))}
+    _emit(results.columns, args, meta, _analyze_view(mech))
     return 0
 
 
-def _report_failures(motion) -> list[dict]:
-    """Warn on stderr about positions that cannot be assembled or are singular."""
-    from assur.base import CANNOT_ASSEMBLE, SINGULAR
-
-    failed = []
-    travelled = table_positions_deg(motion.phi)
-    phi_deg = np.degrees(motion.phi)
-    for code, what, blank in ((CANNOT_ASSEMBLE, "cannot be assembled", "values are empty (nan)"),
-                              (SINGULAR, "is singular", "analogs are empty (nan)")):
-        where = np.flatnonzero(motion.status == code)
-        if len(where):
-            numbers = ", ".join(str(i + 1) for i in where)
-            shown = ", ".join(f"{phi_deg[i]:.6g}" for i in where)
-            _note("warning", f"mechanism '{motion.mechanism.name}' {what} at positions i = {numbers} "
-                             f"(input angle phi = {shown} deg): {blank} in those rows")
-            for i in where:
-                entry = {"position": int(i) + 1, "phi_deg": float(travelled[i]),
-                         "input_angle_deg": float(phi_deg[i]), "problem": what}
-                if code == SINGULAR:  # the least conditioned group: its distance to the singularity
-                    worst = min(motion.conditioning.items(), key=lambda kv: np.nan_to_num(kv[1][i], nan=2.0))
-                    entry.update(group=worst[0], conditioning=float(worst[1][i]))
-                failed.append(entry)
-    failed.sort(key=lambda f: f["position"])
-    return failed
+def _say(results) -> None:
+    """The notes and warnings of a table on stderr."""
+    for line in results.notes:
+        _note("note", line)
+    for line in results.warnings:
+        _note("warning", line)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -570,39 +476,18 @@ def _forces_view(columns: dict) -> list[str]:
 
 
 def _cmd_forces(args: argparse.Namespace) -> int:
-    from .kinetostatics import solve_reactions, virtual_power_residual
-
     mech = load(args.scheme)
-    omega = _speed(args)
-    if omega is None and _declared_dynamics(mech) is not None:
-        omega = _declared_dynamics(mech).mean_speed
-    if omega is None and args.eps != 0:
-        _note("note", "no speed given: omega = 0 with the given eps")
-        omega = 0.0
-    direction = _rotation(mech) if not omega else int(np.sign(omega))
-    n, start = _scheme_defaults(mech, args)
-    phi, start = _table_positions(mech, n, start, direction)
-    motion = analyze(mech, phi, order=2, omega=omega, eps=args.eps, on_failure="mask")
-    failed = _report_failures(motion)
-    ends = np.zeros(len(phi), bool)
-    ends[-1] = True
-    reactions = solve_reactions(motion, ends=ends)
-    for note in reactions.notes:
-        _note("note", note)
-    residual = virtual_power_residual(reactions)
-    columns = reactions.columns(full=True)
-    convention = "K.R, K.angle_deg: the force R[a, b] that link b exerts on link a (pair links = [a, b])"
-    meta = {"scheme": mech.name, "formula": structure_of(mech).formula,
-            "omega": omega, "eps": args.eps, "positions": n, "start": start,
-            "phi0_deg": float(np.degrees(phi[0])), "direction": _table_sense(phi), "convention": convention,
-            "virtual_power_residual_max": float(np.nanmax(residual)) if np.isfinite(residual).any() else None,
-            "failed": failed, "notes": list(reactions.notes)}
+    results = forces_results(mech, args.positions, args.start, _speed(args), args.eps)
+    _say(results)
+    meta = results.meta
     if args.format == "table":
+        omega, phi = meta["omega"], results.motion.phi
+        direction = declared_rotation(mech) if not omega else int(np.sign(omega))
         speed = "none (static analysis)" if omega is None else f"{omega:.6g} rad/s"
-        meta = {"scheme": mech.name, "start": _start_line(mech, phi, start, n, direction),
-                "omega": speed, "eps": f"{args.eps:.6g} rad/s^2", "convention": convention,
+        meta = {"scheme": mech.name, "start": _start_line(mech, phi, meta["start"], meta["positions"], direction),
+                "omega": speed, "eps": f"{args.eps:.6g} rad/s^2", "convention": meta["convention"],
                 "virtual_power_residual_max": meta["virtual_power_residual_max"]}
-    _emit(columns, args, meta, _forces_view)
+    _emit(results.columns, args, meta, _forces_view)
     return 0
 
 
@@ -818,5 +703,4 @@ def _report_warnings(caught) -> None:
         else:
             _note("warning", str(w.message))
     if numerical:
-        _note("warning", "a floating-point overflow or invalid value occurred in the computation: "
-                         "check the results")
+        _note("warning", NUMERICAL_WARNING)

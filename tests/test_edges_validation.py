@@ -426,7 +426,7 @@ def test_cli_refuses_absurd_options_with_status_2(capsys, argv):
 def test_cli_never_prints_a_numpy_warning_or_a_traceback(capsys, monkeypatch):
     """The safety nets: a floating-point warning inside a command becomes one line in the
     library's words; an unexpected exception (a bug) one ``internal error`` line, status 1."""
-    real = linkage.cli.analyze
+    real = linkage.report.results.analyze
 
     def noisy(*args, **kwargs):
         with np.errstate(over="warn"):
@@ -434,7 +434,7 @@ def test_cli_never_prints_a_numpy_warning_or_a_traceback(capsys, monkeypatch):
         warnings.warn("a library warning", UserWarning)
         return real(*args, **kwargs)
 
-    monkeypatch.setattr(linkage.cli, "analyze", noisy)
+    monkeypatch.setattr(linkage.report.results, "analyze", noisy)
     code, out, err = run(capsys, "forces", "four_bar")
     assert code == 0 and out
     assert "RuntimeWarning" not in err and "overflow encountered" not in err, err
@@ -444,7 +444,7 @@ def test_cli_never_prints_a_numpy_warning_or_a_traceback(capsys, monkeypatch):
     def broken(*args, **kwargs):
         raise ZeroDivisionError("division by zero")
 
-    monkeypatch.setattr(linkage.cli, "analyze", broken)
+    monkeypatch.setattr(linkage.report.results, "analyze", broken)
     code, out, err = run(capsys, "forces", "four_bar")
     assert code == 1 and out == "" and "Traceback" not in err
     assert err.strip() == ("linkage: error: internal error (ZeroDivisionError: division by zero); please "

@@ -1,5 +1,7 @@
-"""The results of ``linkage dynamics`` as data: one function computes them for the command line,
-the report folder and the answer keys of course variants, so all three say the same numbers.
+"""The tables of ``linkage analyze``, ``linkage forces`` and ``linkage dynamics`` as data: one
+function per command computes them for the command line, the report folder and the answer keys of
+course variants, so all three say the same numbers. Each returns the columns, the metadata of the
+JSON document and the notes and warnings to say (the command line prints them on stderr).
 
 >>> import linkage
 >>> results = dynamics_results(linkage.load("course_slider_crank"))
@@ -9,16 +11,24 @@ the report folder and the answer keys of course variants, so all three say the s
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import math
+import warnings
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
 from ..dynamics import DynamicsReport, run_dynamics
+from ..errors import InputError
+from ..extremes import table_angles
+from ..kinematics import Motion, analyze, structure_of, table_positions_deg
 from ..model import Mechanism
+from ..scheme import section_of
 from .tables import format_columns, units_of
 
-__all__ = ["DynamicsResults", "dynamics_results", "JSON_CONVENTIONS", "json_document"]
+__all__ = ["JSON_CONVENTIONS", "DynamicsResults", "InputRange", "TableResults", "declared_rotation",
+           "dynamics_results", "failures", "forces_results", "json_document", "kinematics_results",
+           "table_positions"]
 
 #: the ``conventions`` entry of every JSON document the command line writes
 JSON_CONVENTIONS = "see `linkage --help` and docs/conventions.md"
@@ -55,3 +65,184 @@ def json_document(columns: dict[str, Any], meta: dict[str, Any]) -> str:
     """A table as the command line's JSON: ``meta``, ``conventions``, ``units`` and ``rows``."""
     return format_columns(columns, "json", meta={**meta, "conventions": JSON_CONVENTIONS},
                           units=units_of(columns))
+
+
+#: the convention of the reaction columns of ``linkage forces``
+REACTION_CONVENTION = "K.R, K.angle_deg: the force R[a, b] that link b exerts on link a (pair links = [a, b])"
+
+
+@dataclass(frozen=True)
+class InputRange:
+    """A table over the input angles ``a .. b`` (deg) instead of a turn (``--range A B``)."""
+
+    a: float
+    b: float
+
+    @property
+    def span(self) -> tuple[float, float]:
+        """The range in rad."""
+        return math.radians(self.a), math.radians(self.b)
+
+    def __repr__(self) -> str:
+        return f"--range {self.a:g} {self.b:g}"
+
+
+@dataclass(frozen=True)
+class TableResults:
+    """A table of ``linkage analyze`` or ``linkage forces``: ``columns``, the JSON metadata
+    ``meta`` (scheme, positions, start, phi0_deg, direction, failed ...), the ``motion`` analysed,
+    and the ``notes`` and ``warnings`` to say to the user (one line each)."""
+
+    columns: dict[str, np.ndarray]
+    meta: dict[str, Any]
+    motion: Motion
+    notes: list[str] = field(default_factory=list)
+    warnings: list[str] = field(default_factory=list)
+
+    def json(self) -> str:
+        """The JSON document of the command (every column)."""
+        return json_document(self.columns, self.meta)
+
+
+def declared_rotation(mech: Mechanism) -> int:
+    """The order of table positions: the sign of the scheme's declared mean speed, else +1."""
+    spec = section_of(mech, "dynamics")
+    return spec.rotation if spec is not None else 1
+
+
+def table_defaults(mech: Mechanism, positions: int | None = None,
+                   start: str | float | InputRange | None = None) -> tuple[int, str | float | InputRange]:
+    """The number of positions and the start of a table: the given ones, else the scheme's
+    [dynamics] positions and start_deg, else 12 positions from the output's extreme position."""
+    spec = section_of(mech, "dynamics")
+    n = positions if positions is not None else spec.positions if spec is not None else 12
+    start = start if start is not None else spec.start if spec is not None else "extreme"
+    return n, start
+
+
+def table_positions(mech: Mechanism, n: int, start: str | float | InputRange, direction: int,
+                    notes: list[str] | None = None) -> tuple[np.ndarray, str | float]:
+    """Input angles of a table (rad) and the start actually used ("range" over an input range:
+    an :class:`InputRange`, else the scheme's range_deg); what was assumed is appended to
+    ``notes``."""
+    if isinstance(start, InputRange) or mech.input_range is not None:
+        if not (start is None or start == "extreme" or isinstance(start, InputRange)):
+            a, b = np.degrees(mech.input_range)
+            raise InputError(f"scheme '{mech.name}' declares range_deg = [{a:.10g}, {b:.10g}], which fixes "
+                             f"position 1 at {a:.10g} deg: --start {start} applies to a full turn (choose "
+                             "another range with --range A B)")
+        span = start.span if isinstance(start, InputRange) else None
+        return table_angles(mech, n, "extreme", direction, span=span), "range"
+    if isinstance(start, str) and mech.output is None:
+        if notes is not None:
+            notes.append(f"scheme '{mech.name}' declares no output, so it has no extreme position: the table "
+                         "starts at phi = 0 deg (use --start DEG to choose)")
+        start = 0.0
+    try:
+        return table_angles(mech, n, start, direction), start
+    except InputError as exc:  # e.g. the output has no extreme position
+        if isinstance(start, str):
+            raise InputError(f"{exc} (choose position 1 with --start DEG)") from None
+        raise
+
+
+def table_sense(phi: np.ndarray) -> int:
+    """+1 / -1: the sense in which a table's input angles run (``phi = phi0 + direction * phi_deg``)."""
+    return -1 if len(phi) > 1 and phi[-1] < phi[0] else 1
+
+
+def failures(motion: Motion) -> tuple[list[dict], list[str]]:
+    """The positions of ``motion`` that cannot be assembled or are singular: one JSON entry per
+    position (``position``, ``phi_deg``, ``input_angle_deg``, ``problem``; for a singular one the
+    least conditioned ``group`` and its ``conditioning``) and one warning line per problem."""
+    from assur.base import CANNOT_ASSEMBLE, SINGULAR
+
+    failed, lines = [], []
+    travelled = table_positions_deg(motion.phi)
+    phi_deg = np.degrees(motion.phi)
+    for code, what, blank in ((CANNOT_ASSEMBLE, "cannot be assembled", "values are empty (nan)"),
+                              (SINGULAR, "is singular", "analogs are empty (nan)")):
+        where = np.flatnonzero(motion.status == code)
+        if not len(where):
+            continue
+        numbers = ", ".join(str(i + 1) for i in where)
+        shown = ", ".join(f"{phi_deg[i]:.6g}" for i in where)
+        lines.append(f"mechanism '{motion.mechanism.name}' {what} at positions i = {numbers} "
+                     f"(input angle phi = {shown} deg): {blank} in those rows")
+        for i in where:
+            entry = {"position": int(i) + 1, "phi_deg": float(travelled[i]),
+                     "input_angle_deg": float(phi_deg[i]), "problem": what}
+            if code == SINGULAR:  # the least conditioned group: its distance to the singularity
+                worst = min(motion.conditioning.items(), key=lambda kv: np.nan_to_num(kv[1][i], nan=2.0))
+                entry.update(group=worst[0], conditioning=float(worst[1][i]))
+            failed.append(entry)
+    failed.sort(key=lambda f: f["position"])
+    return failed, lines
+
+
+#: a floating-point warning of numpy (overflow, invalid value ...) in the library's words
+NUMERICAL_WARNING = ("a floating-point overflow or invalid value occurred in the computation: check the "
+                     "results")
+
+
+def _caught(caught, failed) -> list[str]:
+    """The warnings recorded during an analysis, as lines: the library's as they are, numpy's
+    floating-point warnings as :data:`NUMERICAL_WARNING` (left out when positions were already
+    reported as failed: they are the noise of those positions)."""
+    lines = [str(w.message) for w in caught if not issubclass(w.category, RuntimeWarning)]
+    if not failed and any(issubclass(w.category, RuntimeWarning) for w in caught):
+        lines.append(NUMERICAL_WARNING)
+    return lines
+
+
+def kinematics_results(mech: Mechanism, positions: int | None = None,
+                       start: str | float | InputRange | None = None) -> TableResults:
+    """The table of ``linkage analyze``: positions and analogs at the scheme's table positions
+    (``positions`` and ``start`` as the command's options)."""
+    direction = declared_rotation(mech)
+    n, start = table_defaults(mech, positions, start)
+    notes: list[str] = []
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        phi, start = table_positions(mech, n, start, direction, notes)
+        motion = analyze(mech, phi, order=2, on_failure="mask")
+        columns = motion.columns()
+    failed, lines = failures(motion)
+    meta = {"scheme": mech.name, "description": mech.description, "formula": structure_of(mech).formula,
+            "positions": n, "start": start, "phi0_deg": float(np.degrees(phi[0])), "direction": table_sense(phi),
+            "failed": failed}
+    return TableResults(columns, meta, motion, notes, lines + _caught(caught, failed))
+
+
+def forces_results(mech: Mechanism, positions: int | None = None, start: str | float | InputRange | None = None,
+                   omega: float | None = None, eps: float = 0.0) -> TableResults:
+    """The table of ``linkage forces``: reactions and the balancing moment at the scheme's table
+    positions, at the input speed ``omega`` (rad/s, signed; default the scheme's mean speed, else
+    a static analysis) and acceleration ``eps`` (rad/s^2)."""
+    from ..kinetostatics import solve_reactions, virtual_power_residual
+
+    notes: list[str] = []
+    spec = section_of(mech, "dynamics")
+    if omega is None and spec is not None:
+        omega = spec.mean_speed
+    if omega is None and eps != 0:
+        notes.append("no speed given: omega = 0 with the given eps")
+        omega = 0.0
+    direction = declared_rotation(mech) if not omega else int(np.sign(omega))
+    n, start = table_defaults(mech, positions, start)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        phi, start = table_positions(mech, n, start, direction, notes)
+        motion = analyze(mech, phi, order=2, omega=omega, eps=eps, on_failure="mask")
+        ends = np.zeros(len(phi), bool)
+        ends[-1] = True
+        reactions = solve_reactions(motion, ends=ends)
+        residual = virtual_power_residual(reactions)
+    failed, lines = failures(motion)
+    notes += list(reactions.notes)
+    meta = {"scheme": mech.name, "formula": structure_of(mech).formula, "omega": omega, "eps": eps,
+            "positions": n, "start": start, "phi0_deg": float(np.degrees(phi[0])), "direction": table_sense(phi),
+            "convention": REACTION_CONVENTION,
+            "virtual_power_residual_max": float(np.nanmax(residual)) if np.isfinite(residual).any() else None,
+            "failed": failed, "notes": list(reactions.notes)}
+    return TableResults(reactions.columns(full=True), meta, motion, notes, lines + _caught(caught, failed))
