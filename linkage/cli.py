@@ -32,6 +32,7 @@ import os
 import re
 import sys
 import warnings
+from pathlib import Path
 from typing import Callable, Sequence
 
 import numpy as np
@@ -643,11 +644,131 @@ def _ode_notes(mech, spec, report) -> None:
 
 
 # ----------------------------------------------------------------------------------------------
+# linkage report, linkage variants
+# ----------------------------------------------------------------------------------------------
+
+
+def _progress(what: str):
+    """A progress bar on stderr (tqdm; shown only when stderr is a terminal) for a stream of
+    ``total`` steps: ``bar(iterable, total)``."""
+    from tqdm import tqdm
+
+    def bar(iterable, total=None):
+        return tqdm(iterable, total=total, desc=f"{PROG}: {what}", unit="step" if total else "draw",
+                    file=sys.stderr, disable=None, leave=False)
+    return bar
+
+
+def _add_report(sub) -> None:
+    p = sub.add_parser(
+        "report", help="a complete analysis folder: tables, pictures, animation, an HTML page",
+        description="Write a complete analysis of a scheme into a folder: the CSV and JSON tables of "
+                    "'analyze', 'forces' and (with a [dynamics] section) 'dynamics'; PNG and SVG "
+                    "pictures (the mechanism to scale, kinematic diagrams, balancing moment, "
+                    "hodographs of reactions, reduced moments and work, energy-inertia diagram, "
+                    "flywheel, omega and eps two ways, start-up with the motor); animation.gif, one "
+                    "revolution; and index.html, one page with the data, the structural formula, the "
+                    "results and every picture. Pictures the scheme's data does not allow are left "
+                    "out with a note. Needs the 'report' extra: pip install \"linkage[report]\".")
+    _add_scheme_argument(p)
+    p.add_argument("--out", "-o", metavar="DIR", required=True, help="the folder to write (created)")
+    p.set_defaults(handler=_cmd_report)
+
+
+def _cmd_report(args: argparse.Namespace) -> int:
+    from .report.folder import require_report_extra, write_report
+
+    require_report_extra()
+    mech = load(args.scheme)
+    report = write_report(mech, args.out, progress=_progress("report"))
+    for line in report.notes:
+        _note("note", line)
+    _out(f"{Path(args.out) / 'index.html'}: {len(report.pictures)} pictures, {len(report.files)} files")
+    return 0
+
+
+def _count(text: str) -> int:
+    try:
+        n = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
+    if not 1 <= n <= 100_000:
+        raise argparse.ArgumentTypeError(f"expected a whole number in [1, 100000], got {n}")
+    return n
+
+
+def _seed(text: str) -> int:
+    try:
+        n = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number >= 0, got {text!r}") from None
+    if n < 0:
+        raise argparse.ArgumentTypeError(f"expected a whole number >= 0, got {n}")
+    return n
+
+
+def _add_variants(sub) -> None:
+    p = sub.add_parser(
+        "variants", help="course assignments: N feasible variants of a template, each with its sheet and key",
+        description="Draw N distinct feasible variants of a template (docs/templates.md; shipped: "
+                    "press_slider_crank, shaper_two_dyad) reproducibly from a seed, or take a "
+                    "teacher's table of given variants (--table), and write one folder per variant: "
+                    "scheme.toml, sheet.pdf (the drawing to scale, the data, what to compute), "
+                    "key.json (the answer key: the fields of 'linkage dynamics scheme.toml --format "
+                    "json' with the same values, plus the parameters and the checks) and the CSV "
+                    "tables; plus index.csv, index.pdf and selection.json (how many draws each "
+                    "feasibility rule rejected). The same seed gives byte-identical files. Needs the "
+                    "'report' extra: pip install \"linkage[report]\".")
+    p.add_argument("template", metavar="TEMPLATE",
+                   help="a shipped template name or the path of a template file")
+    p.add_argument("--count", "-n", metavar="N", type=_count, default=None,
+                   help="variants to make (default: 10; with --table: every row)")
+    p.add_argument("--seed", "-s", metavar="S", type=_seed, default=None,
+                   help="seed of the draws (required without --table)")
+    p.add_argument("--table", metavar="CSV", default=None,
+                   help="a CSV of given variants, one row per variant (columns: the free parameters, "
+                        "optionally 'variant')")
+    p.add_argument("--out", "-o", metavar="DIR", required=True, help="the folder to write (created)")
+    p.add_argument("--workers", "-j", metavar="K", type=_count, default=1,
+                   help="build the variants in K worker processes (default 1)")
+    p.add_argument("--scheduler", metavar="ADDRESS", default=None,
+                   help="build the variants on a Dask distributed cluster at ADDRESS (tcp://host:8786); "
+                        "needs the 'dask' extra: pip install \"linkage[dask]\"")
+    p.add_argument("--max-draws", metavar="D", type=_count, default=None,
+                   help="stop drawing after D draws (default: max(1000, 50 N))")
+    p.set_defaults(handler=_cmd_variants)
+
+
+def _cmd_variants(args: argparse.Namespace) -> int:
+    from .report.folder import require_report_extra
+    from .template import load_template
+    from .variants import select_variants, write_variants
+
+    require_report_extra("linkage variants")
+    if args.table is None and args.seed is None:
+        raise InputError("give --seed S for the draws (or --table CSV of given variants)")
+    if args.table is not None and not Path(args.table).is_file():
+        raise InputError(f"--table {args.table}: no such file")
+    template = load_template(args.template)
+    count = args.count if args.count is not None else (100_000 if args.table is not None else 10)
+    selection = select_variants(template, count, args.seed, given=args.table, max_draws=args.max_draws,
+                                progress=_progress("drawing feasible variants"))
+    for line in selection.lines():
+        _note("note", line)
+    if not selection.variants:
+        raise InputError(f"template '{template.name}': no feasible variant (see the notes above)")
+    folders = write_variants(selection, args.out, workers=args.workers, scheduler=args.scheduler,
+                             progress=_progress("building variants"))
+    _out(f"{Path(args.out) / 'index.csv'}: {len(folders)} variants")
+    return 0 if len(selection.variants) == count or args.table is not None else EXIT_INPUT
+
+
+# ----------------------------------------------------------------------------------------------
 # the parser and main
 # ----------------------------------------------------------------------------------------------
 
 #: functions that register one subcommand each, in the order ``--help`` lists them
-COMMANDS: list[Callable] = [_add_schemes, _add_analyze, _add_forces, _add_dynamics]
+COMMANDS: list[Callable] = [_add_schemes, _add_analyze, _add_forces, _add_dynamics, _add_report, _add_variants]
 
 
 def build_parser() -> argparse.ArgumentParser:

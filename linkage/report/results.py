@@ -91,13 +91,15 @@ class InputRange:
 class TableResults:
     """A table of ``linkage analyze`` or ``linkage forces``: ``columns``, the JSON metadata
     ``meta`` (scheme, positions, start, phi0_deg, direction, failed ...), the ``motion`` analysed,
-    and the ``notes`` and ``warnings`` to say to the user (one line each)."""
+    the ``notes`` and ``warnings`` to say to the user (one line each) and, for ``linkage forces``,
+    the :class:`~linkage.kinetostatics.Reactions` the columns come from."""
 
     columns: dict[str, np.ndarray]
     meta: dict[str, Any]
     motion: Motion
     notes: list[str] = field(default_factory=list)
     warnings: list[str] = field(default_factory=list)
+    reactions: Any = None
 
     def json(self) -> str:
         """The JSON document of the command (every column)."""
@@ -245,4 +247,4 @@ def forces_results(mech: Mechanism, positions: int | None = None, start: str | f
             "convention": REACTION_CONVENTION,
             "virtual_power_residual_max": float(np.nanmax(residual)) if np.isfinite(residual).any() else None,
             "failed": failed, "notes": list(reactions.notes)}
-    return TableResults(reactions.columns(full=True), meta, motion, notes, lines + _caught(caught, failed))
+    return TableResults(reactions.columns(full=True), meta, motion, notes, lines + _caught(caught, failed), reactions)

@@ -1,0 +1,338 @@
+"""A complete analysis folder of one scheme (``linkage report SCHEME --out DIR``).
+
+The folder holds, for machines, the CSV tables of ``linkage analyze``, ``linkage forces`` and
+(with a [dynamics] section) ``linkage dynamics`` and its JSON; for people, ``index.html`` (the
+scheme's data, its structural formula, the results and every picture inline, written with a
+Jinja2 template), the pictures in PNG and SVG and ``animation.gif``, a film of one revolution.
+A picture the scheme's data does not allow (no [dynamics] section: no flywheel; no motor: no
+start-up; no loads and no masses: no hodographs) is left out with a note saying why; the page
+lists the notes too.
+
+Needs the ``report`` extra (matplotlib, Jinja2, tqdm): ``pip install "linkage[report]"``.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import math
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .. import __version__
+from ..errors import InputError, LinkageError
+from ..kinematics import structure_of
+from ..model import Mechanism
+from ..scheme import dumps, section_of
+from .results import dynamics_results, forces_results, kinematics_results
+from .tables import format_columns, units_of
+
+__all__ = ["ReportExtraMissing", "Report", "write_report", "REPORT_EXTRA"]
+
+#: the libraries the report needs (import name -> distribution), all in the ``report`` extra
+REPORT_EXTRA = {"matplotlib": "matplotlib", "jinja2": "Jinja2", "tqdm": "tqdm"}
+
+#: resolution of the PNG pictures, dots per inch (the figures are sized for A4 text width)
+DPI = 150
+
+
+class ReportExtraMissing(LinkageError, ImportError):
+    """A library of the ``report`` extra is not installed."""
+
+
+def require_report_extra(what: str = "linkage report") -> None:
+    """Raise :class:`ReportExtraMissing` naming what to install when a library of the
+    ``report`` extra is missing."""
+    missing = [dist for module, dist in REPORT_EXTRA.items() if importlib.util.find_spec(module) is None]
+    if missing:
+        raise ReportExtraMissing(f"{what} needs the 'report' extra ({', '.join(missing)} missing): "
+                                 "pip install \"linkage[report]\"")
+
+
+@dataclass
+class Report:
+    """What :func:`write_report` wrote: the folder, the files in the order written, and the
+    notes on pictures or tables left out."""
+
+    folder: Path
+    files: list[str] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
+    pictures: list[dict[str, str]] = field(default_factory=list)
+
+
+def write_report(mech: Mechanism, out: str | Path, *,
+                 progress: Callable[[Iterable, int], Iterable] | None = None, frames: int = 72) -> Report:
+    """Write the analysis folder of ``mech`` into ``out`` (created; files of the same names are
+    replaced).
+
+    Parameters
+    ----------
+    mech : Mechanism
+    out : path
+    progress : callable, optional
+        ``progress(steps, total)`` wraps the list of steps (a progress bar).
+    frames : int
+        Frames of the animation over one revolution (or over the input range).
+
+    Returns
+    -------
+    Report
+    """
+    require_report_extra()
+    import matplotlib
+
+    matplotlib.use("Agg")
+    out = Path(out)
+    if out.exists() and not out.is_dir():
+        raise InputError(f"--out {out}: is a file, not a folder")
+    out.mkdir(parents=True, exist_ok=True)
+    report = Report(out)
+    work = _Work(mech, report)
+    steps = work.steps()
+    for step in (progress(steps, len(steps)) if progress is not None else steps):
+        step()
+    work.page()
+    return report
+
+
+class _Work:
+    """The steps of a report, each a method that writes its files (so a progress bar can count
+    them), and the data the page shows."""
+
+    def __init__(self, mech: Mechanism, report: Report):
+        self.mech, self.report = mech, report
+        self.kinematics = self.forces = self.dynamics = None
+        self.spec = section_of(mech, "dynamics")
+
+    def steps(self) -> list[Callable[[], None]]:
+        steps = [self.tables, self.mechanism_pictures, self.kinematic_diagrams, self.force_pictures]
+        if self.spec is not None:
+            steps += [self.dynamics_tables, self.machine_pictures, self.startup]
+        else:
+            self.report.notes.append("dynamics (reduced moments, flywheel, law of motion, start-up): left out "
+                                     "(the scheme declares no [dynamics] section)")
+        steps.append(self.animation)
+        return steps
+
+    # files -------------------------------------------------------------------------------------
+
+    def _write(self, name: str, content: str | bytes) -> None:
+        path = self.report.folder / name
+        path.write_bytes(content.encode() if isinstance(content, str) else content)
+        self.report.files.append(name)
+
+    def _picture(self, name: str, title: str, build: Callable[[], Any]) -> None:
+        """Save the figure ``build()`` returns as ``name``.png and .svg; an InputError (what the
+        picture needs is missing) becomes a note."""
+        import matplotlib.pyplot as plt
+
+        try:
+            fig = build()
+        except InputError as exc:
+            self.report.notes.append(f"{title}: left out ({exc})")
+            return
+        fig = getattr(fig, "figure", fig)  # an Axes -> its Figure
+        try:
+            fig.savefig(self.report.folder / f"{name}.png", dpi=DPI, metadata={"Software": None})
+            fig.savefig(self.report.folder / f"{name}.svg", metadata={"Date": None})
+        finally:
+            plt.close(fig)
+        self.report.files += [f"{name}.png", f"{name}.svg"]
+        self.report.pictures.append({"name": name, "title": title})
+
+    # steps -------------------------------------------------------------------------------------
+
+    def tables(self) -> None:
+        self.kinematics = kinematics_results(self.mech)
+        self.forces = forces_results(self.mech)
+        for results in (self.kinematics, self.forces):
+            self.report.notes += results.notes + results.warnings
+        self._write("scheme.toml", dumps(self.mech))
+        self._write("kinematics.csv", format_columns(self.kinematics.columns, "csv"))
+        self._write("kinematics.json", self.kinematics.json())
+        self._write("forces.csv", format_columns(self.forces.columns, "csv"))
+        self._write("forces.json", self.forces.json())
+
+    def _trajectories(self) -> list[str]:
+        output = self.mech.output
+        if output is None:
+            return []
+        point = output.quantity.split(".")[0]
+        return [point] if point in self.mech.point_names else []
+
+    def mechanism_pictures(self) -> None:
+        from .plots import draw_mechanism, draw_positions
+
+        motion = self.kinematics.motion
+        ok = np.flatnonzero(motion.status == 0)
+        if not len(ok):
+            self.report.notes.append("the mechanism drawings: left out (no position of the table assembles)")
+            return
+        trajectories = self._trajectories()
+        self._picture("mechanism", "The mechanism at position 1, to scale",
+                      lambda: draw_mechanism(motion, int(ok[0]), trajectories=trajectories))
+        spread = [int(i) for i in ok[np.linspace(0, len(ok) - 1, min(4, len(ok))).round().astype(int)]]
+        self._picture("positions", "The mechanism at four table positions, at one scale",
+                      lambda: draw_positions(motion, sorted(set(spread)), trajectories=trajectories))
+
+    def kinematic_diagrams(self) -> None:
+        from .plots import plot_motion
+
+        output = self.mech.output
+        if output is None:
+            self.report.notes.append("kinematic diagrams: left out (the scheme declares no output)")
+            return
+        q = output.quantity
+        self._picture("kinematic_diagrams", f"Kinematic diagrams of the output {q}: position and analogs",
+                      lambda: plot_motion(self.kinematics.motion, [q, q + "'", q + "''"]))
+
+    def force_pictures(self) -> None:
+        from .hodographs import plot_hodographs
+        from .plots import plot_columns
+
+        columns = self.forces.columns
+        moment = np.asarray(columns["balancing_moment"], dtype=float)
+        if not np.any(np.nan_to_num(moment)):
+            self.report.notes.append("balancing moment and hodographs: left out (the scheme declares no loads "
+                                     "and no masses: every reaction is zero)")
+            return
+
+        def balancing():
+            import matplotlib.pyplot as plt
+
+            fig, ax = plt.subplots(figsize=(7.5, 3.4), layout="constrained")
+            plot_columns(columns, ["balancing_moment"], ax, mechanism=self.mech)
+            return fig
+
+        self._picture("balancing_moment", "Balancing moment on the input link (kinetostatics at the scheme's "
+                      "speed)", balancing)
+        self._picture("hodographs", "Hodographs of the reactions in the main pairs",
+                      lambda: plot_hodographs(self.forces.reactions))
+
+    def dynamics_tables(self) -> None:
+        try:
+            self.dynamics = dynamics_results(self.mech)
+        except LinkageError as exc:
+            self.report.notes.append(f"dynamics: left out ({exc})")
+            return
+        self.report.notes += list(self.dynamics.report.notes)
+        self._write("dynamics.csv", format_columns(self.dynamics.columns, "csv"))
+        self._write("dynamics.json", self.dynamics.json())
+
+    def machine_pictures(self) -> None:
+        from . import machine
+        from .plots import plot_dynamics
+
+        if self.dynamics is None:
+            return
+        report = self.dynamics.report
+        self._picture("moments_and_work", "Reduced moments and the work of the forces",
+                      lambda: machine.plot_moments_and_work(report))
+        self._picture("energy_inertia", "Energy–inertia diagram (Wittenbauer)",
+                      lambda: machine.plot_energy_inertia(report))
+        self._picture("flywheel_energy", "Energy change of the flywheel ΔT' and the flywheel (Mertsalov)",
+                      lambda: machine.plot_flywheel_energy(report))
+        self._picture("speed_two_ways", "Angular velocity and acceleration of the crank, two ways",
+                      lambda: machine.plot_speed_two_ways(report))
+        self._picture("law_of_motion", "Law of motion and balancing moment under the real motion",
+                      lambda: plot_dynamics(report, ["omega", "eps", "balancing_moment"]))
+
+    def startup(self) -> None:
+        from . import machine
+
+        if self.spec is None or self.spec.motor is None:
+            self.report.notes.append("start-up from several initial speeds: left out (the scheme declares no "
+                                     "[dynamics.motor])")
+            return
+        self._picture("startup", "Start-up of the machine from several initial speeds",
+                      lambda: machine.plot_startup(self.mech))
+
+    def animation(self) -> None:
+        from .animation import write_animation
+
+        try:
+            write_animation(self.kinematics.motion.mechanism, self.report.folder / "animation.gif",
+                            trajectories=self._trajectories())
+        except InputError as exc:
+            self.report.notes.append(f"animation: left out ({exc})")
+            return
+        self.report.files.append("animation.gif")
+
+    # the page ----------------------------------------------------------------------------------
+
+    def page(self) -> None:
+        import jinja2
+
+        env = jinja2.Environment(loader=jinja2.PackageLoader("linkage.report", "templates"),
+                                 autoescape=jinja2.select_autoescape(["html", "j2"]),
+                                 undefined=jinja2.StrictUndefined, keep_trailing_newline=True)
+        mech = self.mech
+        summary = []
+        if self.dynamics is not None:
+            for key, value in self.dynamics.summary.items():
+                if key in _RESULT_WORDS:
+                    words, unit = _RESULT_WORDS[key]
+                    summary.append({"name": key, "words": words, "value": _number(value), "unit": unit})
+        files = self.report.files
+        tables = [{"name": n, "kind": "CSV" if n.endswith(".csv") else "JSON"}
+                  for n in files if n.endswith((".csv", ".json"))]
+        html = env.get_template("report.html.j2").render(
+            name=mech.name, description=mech.description, formula=structure_of(mech).formula,
+            links=_links(mech), pairs=_pairs(mech), scheme_text=dumps(mech), summary=summary,
+            pictures=self.report.pictures, animation="animation.gif" if "animation.gif" in files else None,
+            tables=tables, notes=self.report.notes, version=__version__,
+            kinematics_units=units_of(self.kinematics.columns) if self.kinematics else {})
+        self._write("index.html", html)
+
+
+#: the scalar results of ``linkage dynamics`` on the page: key -> (words, unit)
+_RESULT_WORDS = {
+    "positions": ("table positions per revolution", ""),
+    "phi0_deg": ("input angle at position 1", "deg"),
+    "direction": ("direction of rotation (+1 counter-clockwise, −1 clockwise)", ""),
+    "method": ("method of the law of motion", ""),
+    "driving_moment": ("constant driving moment M_d (from the cycle balance)", "N·m"),
+    "required_constant_inertia": ("required constant inertia at the crank I' (Mertsalov)", "kg·m²"),
+    "flywheel_inertia": ("flywheel inertia I' − I_0 (— : none needed)", "kg·m²"),
+    "delta_actual": ("coefficient of speed fluctuation δ of the motion", ""),
+    "mean_speed_actual": ("mean angular velocity of the crank ω_m", "rad/s"),
+    "dynamic_coefficient": ("coefficient of dynamics max|M_b| / |M_d|", ""),
+    "constant_inertia": ("constant inertia at the crank with the flywheel", "kg·m²"),
+    "exact_required_constant_inertia": ("required constant inertia, exact energy method", "kg·m²"),
+    "exact_flywheel_inertia": ("flywheel inertia, exact energy method", "kg·m²"),
+    "course_vs_exact_inertia": ("course / exact required inertia − 1", ""),
+    "course_delta_exact": ("δ of the course flywheel, solved exactly", ""),
+}
+
+
+def _number(value: Any) -> str:
+    if value is None:
+        return "—"
+    if isinstance(value, float):
+        return f"{value:.6g}" if math.isfinite(value) else "—"
+    return str(value)
+
+
+def _links(mech: Mechanism) -> list[dict[str, str]]:
+    """The links as the page lists them: name, role, points (local coordinates, m), mass, J."""
+    from .plots import link_role
+
+    rows = []
+    for name in sorted(mech.links, key=lambda n: (n != mech.frame, n)):
+        link = mech.links[name]
+        points = ", ".join(f"{p} ({x:.6g}, {y:.6g})" for p, (x, y) in link.points.items())
+        rows.append({"name": name, "role": link_role(mech, name), "points": points,
+                     "mass": _number(link.mass) if link.mass_declared else "",
+                     "inertia": _number(link.inertia) if link.mass_declared else ""})
+    return rows
+
+
+def _pairs(mech: Mechanism) -> list[dict[str, str]]:
+    from ..model import Prismatic
+
+    return [{"name": name, "kind": "P (prismatic)" if isinstance(pair, Prismatic) else "R (revolute)",
+             "links": " – ".join(pair.links)} for name, pair in sorted(mech.pairs.items())]
+
