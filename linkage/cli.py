@@ -687,24 +687,17 @@ def _cmd_report(args: argparse.Namespace) -> int:
     return 0
 
 
-def _count(text: str) -> int:
-    try:
-        n = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
-    if not 1 <= n <= 100_000:
-        raise argparse.ArgumentTypeError(f"expected a whole number in [1, 100000], got {n}")
-    return n
-
-
-def _seed(text: str) -> int:
-    try:
-        n = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a whole number >= 0, got {text!r}") from None
-    if n < 0:
-        raise argparse.ArgumentTypeError(f"expected a whole number >= 0, got {n}")
-    return n
+def _whole(low: int, high: int) -> Callable[[str], int]:
+    """An argparse type: a whole number in [low, high]."""
+    def parse(text: str) -> int:
+        try:
+            n = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
+        if not low <= n <= high:
+            raise argparse.ArgumentTypeError(f"expected a whole number in [{low}, {high}], got {n}")
+        return n
+    return parse
 
 
 def _add_variants(sub) -> None:
@@ -721,20 +714,20 @@ def _add_variants(sub) -> None:
                     "'report' extra: pip install \"linkage[report]\".")
     p.add_argument("template", metavar="TEMPLATE",
                    help="a shipped template name or the path of a template file")
-    p.add_argument("--count", "-n", metavar="N", type=_count, default=None,
+    p.add_argument("--count", "-n", metavar="N", type=_whole(1, 100_000), default=None,
                    help="variants to make (default: 10; with --table: every row)")
-    p.add_argument("--seed", "-s", metavar="S", type=_seed, default=None,
+    p.add_argument("--seed", "-s", metavar="S", type=_whole(0, 2**63 - 1), default=None,
                    help="seed of the draws (required without --table)")
     p.add_argument("--table", metavar="CSV", default=None,
                    help="a CSV of given variants, one row per variant (columns: the free parameters, "
                         "optionally 'variant')")
     p.add_argument("--out", "-o", metavar="DIR", required=True, help="the folder to write (created)")
-    p.add_argument("--workers", "-j", metavar="K", type=_count, default=1,
+    p.add_argument("--workers", "-j", metavar="K", type=_whole(1, 1024), default=1,
                    help="build the variants in K worker processes (default 1)")
     p.add_argument("--scheduler", metavar="ADDRESS", default=None,
                    help="build the variants on a Dask distributed cluster at ADDRESS (tcp://host:8786); "
                         "needs the 'dask' extra: pip install \"linkage[dask]\"")
-    p.add_argument("--max-draws", metavar="D", type=_count, default=None,
+    p.add_argument("--max-draws", metavar="D", type=_whole(1, 10_000_000), default=None,
                    help="stop drawing after D draws (default: max(1000, 50 N))")
     p.set_defaults(handler=_cmd_variants)
 

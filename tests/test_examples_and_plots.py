@@ -31,7 +31,7 @@ def test_example_runs_and_writes_its_pictures(script, tmp_path):
                           capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stderr
     assert "Traceback" not in done.stderr
-    assert list(tmp_path.glob("*.png")), done.stdout
+    assert list(tmp_path.rglob("*.png")), done.stdout
 
 
 def test_custom_mechanism_example_reports_the_lever_stroke(tmp_path):
