@@ -174,7 +174,9 @@ class _Work:
         trajectories = self._trajectories()
         self._picture("mechanism", "The mechanism at position 1, to scale",
                       lambda: draw_mechanism(motion, int(ok[0]), trajectories=trajectories))
-        spread = [int(i) for i in ok[np.linspace(0, len(ok) - 1, min(4, len(ok))).round().astype(int)]]
+        if self.mech.input_range is None and len(ok) > 1:
+            ok = ok[ok < len(motion.phi) - 1]  # over a turn the last row is position 1 again
+        spread = [int(i) for i in ok[(np.arange(min(4, len(ok))) * len(ok)) // min(4, len(ok))]]
         self._picture("positions", "The mechanism at four table positions, at one scale",
                       lambda: draw_positions(motion, sorted(set(spread)), trajectories=trajectories))
 
