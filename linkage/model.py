@@ -259,6 +259,15 @@ class Mechanism:
         return sorted({p for lk in self.links.values() for p in lk.points})
 
     @property
+    def output_point(self) -> str | None:
+        """The point of the declared output (``B`` of ``B.x``) when the output is a point's
+        coordinate, else None."""
+        if self.output is None:
+            return None
+        name, _, coord = self.output.quantity.rpartition(".")
+        return name if coord in ("x", "y") and name in self.point_names else None
+
+    @property
     def moving_links(self) -> list[str]:
         return sorted(n for n in self.links if n != self.frame)
 

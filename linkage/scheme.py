@@ -11,6 +11,7 @@ True
 from __future__ import annotations
 
 import copy
+import difflib
 import importlib.resources
 import math
 import re
@@ -120,18 +121,35 @@ def shipped_schemes() -> dict[str, Path]:
 
 def scheme_path(name_or_path: str | Path) -> Path:
     """The file of a shipped scheme name, or the given path."""
+    return shipped_or_path(name_or_path, shipped_schemes(), "scheme")
+
+
+def shipped_or_path(name_or_path: str | Path, shipped: Mapping[str, Path], what: str) -> Path:
+    """The file of a shipped ``what`` ("scheme", "template") by name, or the given path; a folder,
+    a missing file or an unknown name is refused naming it (and the shipped names)."""
     path = Path(name_or_path)
     if path.suffix == ".toml" or path.exists():
         if path.is_dir():
-            raise SchemeError(f"{path}: is a folder, not a scheme file (give the path of a .toml file)")
+            raise SchemeError(f"{path}: is a folder, not a {what} file (give the path of a .toml file)")
         if not path.is_file():
-            raise SchemeError(f"{path}: no such scheme file")
+            raise SchemeError(f"{path}: no such {what} file")
         return path
-    shipped = shipped_schemes()
     if str(name_or_path) not in shipped:
-        raise SchemeError(f"unknown scheme {str(name_or_path)!r}: not a file, and not a shipped "
-                          f"scheme ({', '.join(shipped)})")
+        meant = difflib.get_close_matches(str(name_or_path), list(shipped), n=1)
+        raise SchemeError(f"unknown {what} {str(name_or_path)!r}: not a file, and not a shipped "
+                          f"{what} ({', '.join(shipped)})" + (f"; did you mean {meant[0]!r}?" if meant else ""))
     return shipped[str(name_or_path)]
+
+
+def read_text(path: Path, what: str = "scheme") -> str:
+    """The UTF-8 text of a scheme or template file; an unreadable file is refused naming it."""
+    try:
+        return path.read_text(encoding="utf-8")
+    except UnicodeDecodeError as exc:
+        raise SchemeError(f"{path}: not a text file in UTF-8 (byte {exc.start} cannot be read); a "
+                          f"{what} file is TOML text") from None
+    except OSError as exc:
+        raise SchemeError(f"{path}: cannot be read ({exc.strerror})") from None
 
 
 def load(name_or_path: str | Path) -> Mechanism:
@@ -143,14 +161,7 @@ def load(name_or_path: str | Path) -> Mechanism:
         Listing every problem, each prefixed with the file name.
     """
     path = scheme_path(name_or_path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except UnicodeDecodeError as exc:
-        raise SchemeError(f"{path}: not a text file in UTF-8 (byte {exc.start} cannot be read); a "
-                          "scheme file is TOML text") from None
-    except OSError as exc:
-        raise SchemeError(f"{path}: cannot be read ({exc.strerror})") from None
-    return loads(text, source=str(path), default_name=path.stem)
+    return loads(read_text(path), source=str(path), default_name=path.stem)
 
 
 def loads(text: str, source: str = "<string>", default_name: str = "mechanism") -> Mechanism:

@@ -786,16 +786,9 @@ def shipped_templates() -> dict[str, Path]:
 
 def template_path(name_or_path: str | Path) -> Path:
     """The file of a shipped template name, or the given path."""
-    path = Path(name_or_path)
-    if path.suffix == ".toml" or path.exists():
-        if not path.is_file():
-            raise SchemeError(f"{path}: no such template file")
-        return path
-    shipped = shipped_templates()
-    if str(name_or_path) not in shipped:
-        raise SchemeError(f"unknown template {str(name_or_path)!r}: not a file, and not a shipped template"
-                          f"{_hint(str(name_or_path), shipped)}")
-    return shipped[str(name_or_path)]
+    from .scheme import shipped_or_path
+
+    return shipped_or_path(name_or_path, shipped_templates(), "template")
 
 
 def load_template(name_or_path: str | Path) -> Template:
@@ -806,12 +799,10 @@ def load_template(name_or_path: str | Path) -> Template:
     SchemeError
         An unknown name, an unreadable file, or every problem of the template.
     """
+    from .scheme import read_text
+
     path = template_path(name_or_path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise SchemeError(f"{path}: cannot be read as UTF-8 text ({exc})") from None
-    return loads_template(text, source=str(path))
+    return loads_template(read_text(path, "template"), source=str(path))
 
 
 # ----------------------------------------------------------------------------------------------

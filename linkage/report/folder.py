@@ -157,11 +157,8 @@ class _Work:
         self._write("forces.json", self.forces.json())
 
     def _trajectories(self) -> list[str]:
-        output = self.mech.output
-        if output is None:
-            return []
-        point = output.quantity.split(".")[0]
-        return [point] if point in self.mech.point_names else []
+        """The output point's path, drawn on the mechanism's pictures and the film."""
+        return [self.mech.output_point] if self.mech.output_point is not None else []
 
     def mechanism_pictures(self) -> None:
         from .plots import draw_mechanism, draw_positions

@@ -184,14 +184,6 @@ def _rotation(mech: Mechanism) -> int | None:
     return spec.rotation if spec is not None else None
 
 
-def _output_point(mech: Mechanism) -> str | None:
-    """The point of the scheme's output (``B`` of ``B.x``), when the output is a point's coordinate."""
-    if mech.output is None:
-        return None
-    name, _, what = mech.output.quantity.rpartition(".")
-    return name if what in ("x", "y") and name in mech.point_names else None
-
-
 # ----------------------------------------------------------------------------------------------
 # matplotlib without pyplot, text measured and wrapped
 # ----------------------------------------------------------------------------------------------
@@ -475,7 +467,7 @@ def _prepare_drawing(mech: Mechanism, position: int) -> _Drawing:
     if not isinstance(position, (int, np.integer)) or isinstance(position, bool) or not 0 <= position < n:
         raise InputError(f"mechanism '{mech.name}': position must be an index of its table of {n} positions "
                          f"(0 is position 1, {n - 1} position {n}), got {position!r}")
-    point = _output_point(mech)
+    point = mech.output_point
     trajectories = [point] if point else []
     geometry = _Geometry(motion, [int(position)], trajectories)
     scene = geometry.scene(int(position))
