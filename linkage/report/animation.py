@@ -42,13 +42,14 @@ from ..kinematics import Motion, analyze
 from ..model import Mechanism
 from ..scheme import section_of
 from .plots import (
+    _add_artists,
+    _moving_artists,
+    _obstacles,
     _SUPPORT_DIRECTIONS,
     CAPTION_CHARS,
     FONT,
-    LINK_COLOURS,
-    _block_size,
+    PIN,
     _draw_scene,
-    _Drawn,
     _figure_for,
     _Geometry,
     _hull,
@@ -56,8 +57,6 @@ from .plots import (
     _limits,
     _place_labels,
     _pyplot,
-    _rail_hatch,
-    _rect,
     _samples,
     _Scene,
     _support,
@@ -235,7 +234,7 @@ class Film:
         FigureCanvasAgg(self.figure)          # pixels of its own, whatever pyplot's backend
         self.ax = self.figure.add_axes(rects[0])
         _draw_scene(self.ax, _still(self.scenes[0]), self.geometry, self.limits, False, "")
-        self._still_obstacles = _obstacles(_still(self.scenes[0]), self.geometry.unit)
+        self._still_obstacles = _obstacles(_still(self.scenes[0]), self.geometry.unit, trajectory_step=3)
         self._moving: list = []
         self._background = None
         self._renderer = None
@@ -257,9 +256,9 @@ class Film:
         for artist in self._moving:
             artist.remove()
         sc, u = self.scenes[k], self.geometry.unit
-        moving = _draw_moving(self.ax, sc, self.geometry)
+        moving = _add_artists(self.ax, _moving_artists(sc, self.geometry))
         if self.labels:
-            drawn = _obstacles(_moving_part(sc), u, self._still_obstacles)
+            drawn = _obstacles(_moving_part(sc), u, self._still_obstacles, trajectory_step=3)
             before = set(self.ax.texts)
             wanted = list(sc.points) if self.labels is True else [n for n in self.labels if n in sc.points]
             _place_labels(self.ax, sc, wanted, drawn, FONT, PIN * u)
@@ -316,10 +315,6 @@ class Film:
         return "\n".join(head + [moved] + note)
 
 
-#: radius of a revolute pair's circle, in units of the drawing's symbol size (as draw_mechanism)
-PIN = 0.42
-#: radius of a point's dot, in the same units
-DOT = 0.22
 #: gap between the axes and the caption, points (matplotlib's title pad)
 TITLE_PAD = 6.0
 #: colours of a film's palette: the most frequent ones exactly, the antialiased edges to the
@@ -358,78 +353,6 @@ def _still(sc: _Scene) -> _Scene:
 
 def _moving_part(sc: _Scene) -> _Scene:
     return _Scene(points=sc.points, bodies=sc.bodies, slots=sc.slots, blocks=sc.blocks, pins=sc.pins, dots=sc.dots)
-
-
-def _obstacles(sc: _Scene, u: float, base: _Drawn | None = None) -> _Drawn:
-    """What the labels must keep clear of, as :func:`~linkage.report.plots._draw_scene` records
-    it (added to a copy of ``base``); trajectories at every third point (they are light
-    obstacles, and the search for the labels' places is quicker on fewer segments)."""
-    drawn = _Drawn()
-    if base is not None:
-        drawn.segments, drawn.light = list(base.segments), list(base.light)
-        drawn.discs, drawn.areas = list(base.discs), list(base.areas)
-    for _, _, curve in sc.trajectories:
-        drawn.polyline(np.vstack([curve[::3], curve[-1:]]), light=True)
-    for line, side in sc.rails:
-        surface, strokes = _rail_hatch(line, side, u)
-        for polyline in (line, surface, *strokes):
-            drawn.polyline(polyline)
-    for p, direction in sc.pivots:
-        tri, ground, strokes = _support(p, direction, u)
-        drawn.polyline(tri, closed=True)
-        for polyline in (ground, *strokes):
-            drawn.polyline(polyline)
-    for _, poly in sc.bodies:
-        drawn.polyline(poly, closed=len(poly) >= 3)
-        if len(poly) >= 3:
-            drawn.areas.append(poly)
-    for _, line in sc.slots:
-        drawn.polyline(line)
-    for _, centre, angle, on_frame in sc.blocks:
-        rect = _rect(centre, angle, *_block_size(u, on_frame))
-        drawn.polyline(rect, closed=True)
-        drawn.areas.append(rect)
-    drawn.discs += [(p, PIN * u) for _, p in sc.pins] + [(sc.points[n], DOT * u) for n in sc.dots]
-    return drawn
-
-
-def _draw_moving(ax, sc: _Scene, geometry: _Geometry) -> list:
-    """Links, slots, sliders and blocks, pairs and points of one frame, drawn as
-    :func:`~linkage.report.plots._draw_scene` draws them (colours, widths, layers and ids).
-    Added with ``add_artist``: the axis limits are fixed, so no data limits are updated."""
-    from matplotlib.lines import Line2D
-    from matplotlib.patches import Circle, Polygon
-
-    mech, u = geometry.mech, geometry.unit
-    colour = {link: LINK_COLOURS[k % len(LINK_COLOURS)] for k, link in enumerate(mech.moving_links)}
-    out = []
-    for link, poly in sc.bodies:
-        c = colour[link]
-        if len(poly) >= 3:
-            out.append(Polygon(poly, closed=True, fc=c, alpha=0.18, ec="none", zorder=4, gid=f"link:{link}"))
-            out.append(Polygon(poly, closed=True, fill=False, ec=c, lw=3.0, joinstyle="round", zorder=5,
-                               gid=f"link-edge:{link}"))
-        else:
-            out.append(Line2D(poly[:, 0], poly[:, 1], color=c, lw=3.5, solid_capstyle="round", zorder=5,
-                              gid=f"link:{link}"))
-    for link, line in sc.slots:
-        out.append(Line2D(line[:, 0], line[:, 1], color=colour[link], lw=5.0, solid_capstyle="butt", zorder=5,
-                          gid=f"slot:{link}"))
-        out.append(Line2D(line[:, 0], line[:, 1], color="white", lw=1.4, solid_capstyle="butt", zorder=5.1))
-    for link, centre, angle, on_frame in sc.blocks:
-        rect = _rect(centre, angle, *_block_size(u, on_frame))
-        out.append(Polygon(rect, closed=True, fc="white", ec=colour[link], lw=2.2, zorder=6.5 if on_frame else 7,
-                           gid=f"block:{link}"))
-        out.append(Polygon(rect, closed=True, fc=colour[link], alpha=0.25, ec="none",
-                           zorder=6.6 if on_frame else 7.1))
-    for name, p in sc.pins:
-        out.append(Circle(p, PIN * u, fc="white", ec="black", lw=1.4, zorder=8, gid=f"pair:{name}"))
-    for name in sc.dots:
-        out.append(Circle(sc.points[name], DOT * u, fc="black", ec="none", zorder=8, gid=f"point:{name}"))
-    for artist in out:
-        artist.set_transform(ax.transData)
-        ax.add_artist(artist)
-    return out
 
 
 def _check_dpi(dpi) -> None:

@@ -1318,71 +1318,28 @@ def draw_positions(motion, positions: Sequence[int] | None = None, *, ncols: int
 def _draw_scene(ax, sc: _Scene, geometry: _Geometry, limits, labels, caption: str, font: int = FONT,
                 centred: bool = False) -> None:
     from matplotlib.collections import LineCollection
-    from matplotlib.patches import Circle, Polygon
+    from matplotlib.patches import Polygon
 
     mech, u = geometry.mech, geometry.unit
-    drawn = _Drawn()
     colour = {link: LINK_COLOURS[k % len(LINK_COLOURS)] for k, link in enumerate(mech.moving_links)}
     # trajectories, under everything
     for name, link, curve in sc.trajectories:
         ax.plot(curve[:, 0], curve[:, 1], ls=(0, (5, 3)), lw=1.2, color=colour.get(link, "0.3"), zorder=1,
                 gid=f"trajectory:{name}")
-        drawn.polyline(curve, light=True)
     # frame guides: centre line, surface and hatching
     for line, side in sc.rails:
         surface, strokes = _rail_hatch(line, side, u)
         ax.plot(line[:, 0], line[:, 1], color="0.35", lw=0.8, ls=(0, (8, 3, 2, 3)), zorder=2, gid="guide")
         ax.plot(surface[:, 0], surface[:, 1], color="black", lw=1.4, zorder=2, gid="guide-surface")
         ax.add_collection(LineCollection(strokes, colors="black", linewidths=0.8, zorder=2, gid="hatching"))
-        drawn.polyline(line)
-        drawn.polyline(surface)
-        for s in strokes:
-            drawn.polyline(s)
     # frame pivots' supports
     for p, direction in sc.pivots:
         tri, ground, strokes = _support(p, direction, u)
         ax.add_patch(Polygon(tri, closed=True, fc="white", ec="black", lw=1.2, zorder=3, gid="support"))
         ax.plot(ground[:, 0], ground[:, 1], color="black", lw=1.4, zorder=3, gid="support-base")
         ax.add_collection(LineCollection(strokes, colors="black", linewidths=0.8, zorder=3, gid="hatching"))
-        drawn.polyline(tri, closed=True)
-        drawn.polyline(ground)
-        for s in strokes:
-            drawn.polyline(s)
-    # links
-    for link, poly in sc.bodies:
-        c = colour[link]
-        if len(poly) >= 3:
-            ax.add_patch(Polygon(poly, closed=True, fc=c, alpha=0.18, ec="none", zorder=4, gid=f"link:{link}"))
-            ax.add_patch(Polygon(poly, closed=True, fill=False, ec=c, lw=3.0, joinstyle="round", zorder=5,
-                                 gid=f"link-edge:{link}"))
-            drawn.polyline(poly, closed=True)
-            drawn.areas.append(poly)
-        else:
-            ax.plot(poly[:, 0], poly[:, 1], color=c, lw=3.5, solid_capstyle="round", zorder=5, gid=f"link:{link}")
-            drawn.polyline(poly)
-    for link, line in sc.slots:
-        ax.plot(line[:, 0], line[:, 1], color=colour[link], lw=5.0, solid_capstyle="butt", zorder=5,
-                gid=f"slot:{link}")
-        ax.plot(line[:, 0], line[:, 1], color="white", lw=1.4, solid_capstyle="butt", zorder=5.1)
-        drawn.polyline(line)
-    # sliders and blocks
-    for link, centre, angle, on_frame in sc.blocks:
-        rect = _rect(centre, angle, *_block_size(u, on_frame))
-        ax.add_patch(Polygon(rect, closed=True, fc="white", ec=colour[link], lw=2.2, zorder=6.5 if on_frame else 7,
-                             gid=f"block:{link}"))
-        ax.add_patch(Polygon(rect, closed=True, fc=colour[link], alpha=0.25, ec="none",
-                             zorder=6.6 if on_frame else 7.1))
-        drawn.polyline(rect, closed=True)
-        drawn.areas.append(rect)
-    # revolute pairs and other points
-    r = 0.42 * u
-    for name, p in sc.pins:
-        ax.add_patch(Circle(p, r, fc="white", ec="black", lw=1.4, zorder=8, gid=f"pair:{name}"))
-        drawn.discs.append((p, r))
-    for name in sc.dots:
-        p = sc.points[name]
-        ax.add_patch(Circle(p, 0.22 * u, fc="black", ec="none", zorder=8, gid=f"point:{name}"))
-        drawn.discs.append((p, 0.22 * u))
+    # links, slots, sliders and blocks, pairs and points
+    _add_artists(ax, _moving_artists(sc, geometry))
     x0, x1, y0, y1 = limits
     ax.set_xlim(x0, x1)
     ax.set_ylim(y0, y1)
@@ -1397,7 +1354,98 @@ def _draw_scene(ax, sc: _Scene, geometry: _Geometry, limits, labels, caption: st
         ax.set_title(caption, fontsize=font, loc="center" if centred else "left")
     if labels:
         wanted = list(sc.points) if labels is True else [n for n in labels if n in sc.points]
-        _place_labels(ax, sc, wanted, drawn, font, r)
+        _place_labels(ax, sc, wanted, _obstacles(sc, u), font, PIN * u)
+
+
+#: radius of a revolute pair's circle and of a point's dot, in the drawing's unit (a tenth of
+#: the mechanism's size: :attr:`_Geometry.unit`)
+PIN = 0.42
+DOT = 0.22
+
+
+def _obstacles(sc: _Scene, u: float, base: _Drawn | None = None, trajectory_step: int = 1) -> _Drawn:
+    """What the labels of a scene must keep clear of (added to a copy of ``base``): every line,
+    area and disc drawn; trajectories at every ``trajectory_step``-th point (light obstacles: a
+    film searches its labels' places quicker on fewer segments)."""
+    drawn = _Drawn()
+    if base is not None:
+        drawn.segments, drawn.light = list(base.segments), list(base.light)
+        drawn.discs, drawn.areas = list(base.discs), list(base.areas)
+    for _, _, curve in sc.trajectories:
+        drawn.polyline(np.vstack([curve[::trajectory_step], curve[-1:]]), light=True)
+    for line, side in sc.rails:
+        surface, strokes = _rail_hatch(line, side, u)
+        for polyline in (line, surface, *strokes):
+            drawn.polyline(polyline)
+    for p, direction in sc.pivots:
+        tri, ground, strokes = _support(p, direction, u)
+        drawn.polyline(tri, closed=True)
+        for polyline in (ground, *strokes):
+            drawn.polyline(polyline)
+    for _, poly in sc.bodies:
+        drawn.polyline(poly, closed=len(poly) >= 3)
+        if len(poly) >= 3:
+            drawn.areas.append(poly)
+    for _, line in sc.slots:
+        drawn.polyline(line)
+    for _, centre, angle, on_frame in sc.blocks:
+        rect = _rect(centre, angle, *_block_size(u, on_frame))
+        drawn.polyline(rect, closed=True)
+        drawn.areas.append(rect)
+    drawn.discs += [(p, PIN * u) for _, p in sc.pins] + [(sc.points[n], DOT * u) for n in sc.dots]
+    return drawn
+
+
+def _moving_artists(sc: _Scene, geometry: _Geometry) -> list:
+    """The artists of a scene's moving parts: links, slots, sliders and blocks, pairs and points
+    (colours, widths, layers and ids shared by the drawings and the film; add them with
+    :func:`_add_artists`)."""
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Circle, Polygon
+
+    mech, u = geometry.mech, geometry.unit
+    colour = {link: LINK_COLOURS[k % len(LINK_COLOURS)] for k, link in enumerate(mech.moving_links)}
+    out = []
+    for link, poly in sc.bodies:
+        c = colour[link]
+        if len(poly) >= 3:
+            out.append(Polygon(poly, closed=True, fc=c, alpha=0.18, ec="none", zorder=4, gid=f"link:{link}"))
+            out.append(Polygon(poly, closed=True, fill=False, ec=c, lw=3.0, joinstyle="round", zorder=5,
+                               gid=f"link-edge:{link}"))
+        else:
+            out.append(Line2D(poly[:, 0], poly[:, 1], color=c, lw=3.5, solid_capstyle="round", zorder=5,
+                              gid=f"link:{link}"))
+    for link, line in sc.slots:
+        out.append(Line2D(line[:, 0], line[:, 1], color=colour[link], lw=5.0, solid_capstyle="butt", zorder=5,
+                          gid=f"slot:{link}"))
+        out.append(Line2D(line[:, 0], line[:, 1], color="white", lw=1.4, solid_capstyle="butt", zorder=5.1))
+    for link, centre, angle, on_frame in sc.blocks:
+        rect = _rect(centre, angle, *_block_size(u, on_frame))
+        out.append(Polygon(rect, closed=True, fc="white", ec=colour[link], lw=2.2, zorder=6.5 if on_frame else 7,
+                           gid=f"block:{link}"))
+        out.append(Polygon(rect, closed=True, fc=colour[link], alpha=0.25, ec="none",
+                           zorder=6.6 if on_frame else 7.1))
+    for name, p in sc.pins:
+        out.append(Circle(p, PIN * u, fc="white", ec="black", lw=1.4, zorder=8, gid=f"pair:{name}"))
+    for name in sc.dots:
+        out.append(Circle(sc.points[name], DOT * u, fc="black", ec="none", zorder=8, gid=f"point:{name}"))
+    return out
+
+
+def _add_artists(ax, artists: list) -> list:
+    """Add lines, patches and collections to ``ax`` (each where matplotlib keeps its kind)."""
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
+
+    for artist in artists:
+        if isinstance(artist, Line2D):
+            ax.add_line(artist)
+        elif isinstance(artist, Patch):
+            ax.add_patch(artist)
+        else:
+            ax.add_collection(artist)
+    return artists
+
 
 
 def _metre_ticks(ax) -> None:
