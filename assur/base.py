@@ -47,6 +47,7 @@ __all__ = [
     "PrismaticJoint",
     "Group",
     "GroupPosition",
+    "GroupSolution",
     "rotate",
     "perp",
     "global_point",
@@ -252,6 +253,18 @@ class GroupPosition:
     error_bound: np.ndarray    # bound of the relative error of the first analogs (inf: not assembled)
 
 
+@dataclass(frozen=True)
+class GroupSolution(GroupPosition):
+    """Result of :meth:`Group.solve`: a :class:`GroupPosition` with the group's analogs.
+
+    ``first`` and ``second`` map each of the group's links to ``(N, 3)`` analogs (NaN where the
+    status is not OK), or are ``None`` when not asked for.
+    """
+
+    first: dict[str, np.ndarray] | None = None
+    second: dict[str, np.ndarray] | None = None
+
+
 class Group(ABC):
     """Base class of Assur group solvers (see the module docstring for the plug-in contract).
 
@@ -445,6 +458,21 @@ class Group(ABC):
         q2 = np.linalg.solve(phi_q, rhs2[..., None])[..., 0]
         q2[~ok] = np.nan
         return d1, self._split(q2)
+
+    def solve(self, poses: Poses, first: Poses | None = None, second: Poses | None = None, branch: int = 1,
+              input_error=0.0) -> GroupSolution:
+        """Positions, statuses and analogs in one call: :meth:`position` then :meth:`analogs`.
+
+        ``first`` (and ``second``) are the analogs of the known links; without them only
+        positions are solved. Kinds with a fast path (the dyads) override this with the same
+        results computed elementwise; this generic version is their oracle.
+        """
+        placed = self.position(poses, branch, input_error)
+        d1 = d2 = None
+        if first is not None:
+            d1, d2 = self.analogs({**poses, **placed.poses}, first, second, valid=placed.status == OK)
+        return GroupSolution(placed.poses, placed.status, placed.jacobian_sign, placed.conditioning,
+                             placed.error_bound, d1, d2)
 
     def _split(self, q: np.ndarray) -> dict[str, np.ndarray]:
         return {link: q[:, 3 * i : 3 * i + 3] for i, link in enumerate(self.links)}

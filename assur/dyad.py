@@ -7,11 +7,14 @@ that ``PRR`` is recognised as ``RRP`` with the links swapped.
 
 from __future__ import annotations
 
+from abc import abstractmethod
 from typing import ClassVar
 
 import numpy as np
 
-from .base import Group, Joint, PrismaticJoint, angle_of, global_point, rotate
+from .base import (ANALOG_TOL, CANNOT_ASSEMBLE, CLOSURE_TOL, OK, ROUNDOFF_FACTOR, SINGULAR, Group,
+                   GroupSolution, Joint, PrismaticJoint)
+from .rows import arm, frame, rows_of, xy
 
 __all__ = ["Dyad"]
 
@@ -48,32 +51,180 @@ class Dyad(Group):
                 return cls((l1, l2), (ext1, inner, ext2), size, ext1, inner, ext2)
         return None
 
-    # -- helpers for closed forms ----------------------------------------------------------------
+    # -- the fast path ------------------------------------------------------------------------
+    def solve(self, poses, first=None, second=None, branch: int = 1, input_error=0.0,
+              frames=None) -> GroupSolution:
+        """:meth:`Group.solve` in closed form: the same statuses, conditioning, bounds and analogs.
+
+        The six unknowns of the analog systems are eliminated pair by pair: each external pair
+        fixes its link's velocity up to one parameter along the null vector of its two rows, and
+        the inner pair's two rows give those two parameters (a 2x2 system whose determinant is
+        the determinant of the group Jacobian). ``frames`` may carry the known links' frames
+        (:func:`assur.rows.frame`) computed once for every group that uses them.
+        """
+        if branch not in self.branches:
+            raise ValueError(f"{self!r}: branch must be one of {self.branches}, got {branch!r}")
+        frames = {} if frames is None else frames
+        for link in self.known_links:
+            if link not in frames:
+                frames[link] = frame(poses[link])
+        placed, ok = self._place(frames, branch)
+        frames.update(placed)
+        ext1, inner, ext2 = rows = [rows_of(j, frames) for j in self.joints]
+        closure = np.maximum(np.maximum(ext1.residual(frames, self.size), inner.residual(frames, self.size)),
+                             ext2.residual(frames, self.size))
+        with np.errstate(invalid="ignore"):
+            assembled = ok & (closure <= CLOSURE_TOL * self.size)   # False where NaN
+        l1, l2 = self.links
+        ratio, det = self._conditioning(rows, frames)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            own = ROUNDOFF_FACTOR * np.finfo(float).eps / (ratio * ratio)
+            bound = np.where(ratio > 0, own, np.inf) + np.where(np.asarray(input_error) > 0, input_error / ratio, 0.0)
+        bound = np.where(assembled, bound, np.inf)
+        status = np.where(assembled, np.where(bound <= ANALOG_TOL, OK, SINGULAR), CANNOT_ASSEMBLE)
+        sign = np.where(assembled, np.sign(det), 0.0)
+        conditioning = np.where(assembled, ratio, np.nan)
+        if not assembled.all():    # later groups see NaN where this one is not assembled
+            placed = {k: tuple(np.where(assembled, c, np.nan) for c in f) for k, f in placed.items()}
+            frames.update(placed)
+        new = {k: _pose_array((f[0], f[1], f[4]), ~assembled) for k, f in placed.items()}
+        d1 = d2 = None
+        if first is not None:
+            bad = status != OK
+            with np.errstate(divide="ignore", invalid="ignore"):
+                det_safe = np.where(bad, 1.0, det)
+                known = {k: _columns(first[k]) for k in self.known_links}
+                q1, q2 = self._eliminate(rows, known, None, det_safe)
+                d1 = {l1: _pose_array(q1, bad), l2: _pose_array(q2, bad)}
+                if second is not None:
+                    all_first = {**known, l1: q1, l2: q2}
+                    gammas = [r.quadratic(all_first) for r in rows]
+                    known2 = {k: _columns(second[k]) for k in self.known_links}
+                    a1, a2 = self._eliminate(rows, known2, gammas, det_safe)
+                    d2 = {l1: _pose_array(a1, bad), l2: _pose_array(a2, bad)}
+        return GroupSolution(new, status, sign, conditioning, bound, d1, d2)
+
+    def _eliminate(self, rows, known, gammas, det):
+        """Generalized velocities ``(tx, ty, w)`` of L1 and L2 from the rows' right-hand sides
+        ``gamma - Phi_k q_k`` (``gamma`` = 0 for first analogs)."""
+        l1, l2 = self.links
+        ext1, inner, ext2 = rows
+
+        def rhs(r, i, link):
+            other = r.links[0] if r.links[1] == link else r.links[1]
+            k0, k1 = r.act(other, known[other])
+            if gammas is None:
+                return -k0, -k1
+            return gammas[i][0] - k0, gammas[i][1] - k1
+
+        p1, n1 = ext1.particular(l1, rhs(ext1, 0, l1))
+        p2, n2 = ext2.particular(l2, rhs(ext2, 2, l2))
+        c1, c2 = inner.act(l1, n1), inner.act(l2, n2)
+        a1, a2 = inner.act(l1, p1), inner.act(l2, p2)
+        g = (0.0, 0.0) if gammas is None else gammas[1]
+        rx, ry = g[0] - a1[0] - a2[0], g[1] - a1[1] - a2[1]
+        tau1 = (rx * c2[1] - ry * c2[0]) / det
+        tau2 = (c1[0] * ry - c1[1] * rx) / det
+        return ([p + tau1 * n for p, n in zip(p1, n1)], [p + tau2 * n for p, n in zip(p2, n2)])
+
+    def _conditioning(self, rows, frames):
+        """:meth:`Group.conditioning` elementwise: the Hadamard ratio ``(N,)`` of the scaled
+        Jacobian and the determinant ``(N,)`` of the unscaled one."""
+        l1, l2 = self.links
+        ext1, inner, ext2 = rows
+        (ax, ay), (bx, by), (cx, cy) = ext1.contact, inner.contact, ext2.contact
+        spread = np.maximum(np.maximum(np.hypot(bx - ax, by - ay), np.hypot(cx - bx, cy - by)),
+                            np.hypot(cx - ax, cy - ay))
+        biggest = np.maximum(np.maximum(np.maximum(np.abs(ax), np.abs(ay)), np.maximum(np.abs(bx), np.abs(by))),
+                             np.maximum(np.abs(cx), np.abs(cy)))
+        scale = np.maximum(spread, 1e-12 * biggest)
+        scale = np.where(scale > 0, scale, 1.0)
+        centroid = {l1: (0.5 * (ax + bx), 0.5 * (ay + by)), l2: (0.5 * (bx + cx), 0.5 * (by + cy))}
+        product = 1.0
+        for r in rows:
+            row0 = row1 = 0.0
+            for link in (l1, l2):
+                if link in r.links:
+                    s0, s1 = r.norms_squared(link, centroid[link], frames[link], scale)
+                    row0, row1 = row0 + s0, row1 + s1
+            product = product * row0 * row1
+        _, n1 = ext1.particular(l1, (0.0, 0.0))
+        _, n2 = ext2.particular(l2, (0.0, 0.0))
+        c1, c2 = inner.act(l1, n1), inner.act(l2, n2)
+        det = c1[0] * c2[1] - c1[1] * c2[0]
+        prismatic = sum(r.kind == "P" for r in rows)
+        with np.errstate(invalid="ignore"):
+            ratio = np.abs(det) * scale ** (prismatic - 2) / np.sqrt(product)
+        return ratio, det
+
+    # -- positions -----------------------------------------------------------------------------
+    def _position(self, poses, branch):
+        frames = {k: frame(poses[k]) for k in self.known_links}
+        placed, ok = self._place(frames, branch)
+        return {k: np.column_stack([f[0], f[1], f[4]]) for k, f in placed.items()}, ok
+
+    @abstractmethod
+    def _place(self, frames, branch):
+        """Hook: ``({link: frame}, assembled)`` of the group's links in closed form, from the known
+        links' frames ``(x, y, c, s, theta)`` (:func:`assur.rows.frame`)."""
+
+    def _frames(self, poses):
+        return {k: frame(poses[k]) for k in self.known_links}
+
+    # -- helpers for closed forms (vectors as (x, y) pairs of (N,) arrays) ------------------------
     @staticmethod
-    def known_point(poses, joint: Joint, link: str) -> np.ndarray:
-        """Global position of ``joint``'s point as carried by the known link (not ``link``)."""
+    def known_point(frames, joint: Joint, link: str):
+        """Global position ``(x, y)`` of ``joint``'s point as carried by the known link (not ``link``)."""
         _, other, p_other = joint.local(link)
-        return global_point(poses[other], p_other)
+        f = frames[other]
+        rx, ry = arm(f, xy(p_other))
+        return f[0] + rx, f[1] + ry
 
     @staticmethod
-    def guide_line(poses, joint: PrismaticJoint):
-        """Global point and unit direction ``(N, 2)`` of a prismatic joint's guide line."""
-        theta = poses[joint.a][:, 2]
-        return global_point(poses[joint.a], joint.g), rotate(theta, joint.u)
+    def guide_line(frames, joint: PrismaticJoint):
+        """Global point ``(x, y)`` and unit direction ``(x, y)`` of a prismatic joint's guide line."""
+        f = frames[joint.a]
+        gx, gy = arm(f, xy(joint.g))
+        return (f[0] + gx, f[1] + gy), arm(f, xy(joint.u))
 
     @staticmethod
-    def place_by_two_points(p_global_1, p_global_2, p_local_1, p_local_2):
-        """Pose ``(N, 3)`` of a link whose local points 1 and 2 are at the global positions."""
-        theta = angle_of(p_global_2 - p_global_1) - np.arctan2(
-            p_local_2[1] - p_local_1[1], p_local_2[0] - p_local_1[0]
-        )
-        origin = p_global_1 - rotate(theta, p_local_1)
-        return np.column_stack([origin, theta])
+    def turned(f, beta):
+        """``(c, s, theta)`` of the angle ``theta + beta`` for a frame ``f``."""
+        cb, sb = np.cos(beta), np.sin(beta)
+        return f[2] * cb - f[3] * sb, f[3] * cb + f[2] * sb, f[4] + beta
 
     @staticmethod
-    def place_by_point_and_angle(p_global, p_local, theta) -> np.ndarray:
-        """Pose ``(N, 3)`` of a link with angle ``theta`` whose local point is at ``p_global``."""
-        return np.column_stack([p_global - rotate(theta, p_local), theta])
+    def place_by_two_points(p1, p2, local_1, local_2, length):
+        """Frame of a link whose local points 1 and 2 (``(2,)`` or ``(N, 2)``) are at the global
+        points ``p1``, ``p2`` (``(x, y)``), ``length`` apart."""
+        (ax, ay), (bx, by) = xy(local_1), xy(local_2)
+        offset = np.arctan2(by - ay, bx - ax)
+        dx, dy = p2[0] - p1[0], p2[1] - p1[1]
+        theta = np.arctan2(dy, dx) - offset
+        ux, uy = dx / length, dy / length
+        co, so = np.cos(offset), np.sin(offset)
+        c, s = ux * co + uy * so, uy * co - ux * so
+        return p1[0] - (c * ax - s * ay), p1[1] - (s * ax + c * ay), c, s, theta
+
+    @staticmethod
+    def place_by_point_and_angle(p, local, c, s, theta):
+        """Frame of a link with angle ``theta`` (cosine ``c``, sine ``s``) whose local point is at ``p``."""
+        px, py = xy(local)
+        return p[0] - (c * px - s * py), p[1] - (s * px + c * py), c, s, theta
+
+
+def _columns(q: np.ndarray):
+    """``(N, 3)`` analogs as three ``(N,)`` columns."""
+    return q[:, 0], q[:, 1], q[:, 2]
+
+
+def _pose_array(q, bad: np.ndarray) -> np.ndarray:
+    """Three columns as an ``(N, 3)`` array, NaN at the positions ``bad``."""
+    out = np.empty((len(bad), 3))
+    for i, column in enumerate(q):
+        out[:, i] = column
+    out[bad] = np.nan
+    return out
 
 
 def _arrange(l1: str, l2: str, joints, known):

@@ -8,8 +8,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .base import cross, rotate
 from .dyad import Dyad
+from .rows import xy
 
 __all__ = ["PRP"]
 
@@ -19,24 +19,23 @@ class PRP(Dyad):
     branches = (1,)
     slider_roles = {"ext1": "L1", "ext2": "L2"}
 
-    def _position(self, poses, branch):
+    def _place(self, frames, branch):
         l1, l2 = self.links
-        b1_loc, _, _ = self.inner.local(l1)
-        b2_loc, _, _ = self.inner.local(l2)
-        lines, thetas = [], []
-        for guide, b_loc in ((self.ext1, b1_loc), (self.ext2, b2_loc)):
-            G, u = self.guide_line(poses, guide)
-            theta = poses[guide.a][:, 2] + guide.beta
-            lines.append((G + rotate(theta, np.subtract(b_loc, guide.p)), u))
-            thetas.append(theta)
+        lines, angles = [], []
+        for guide, link in ((self.ext1, l1), (self.ext2, l2)):
+            G, u = self.guide_line(frames, guide)
+            c, s, theta = self.turned(frames[guide.a], guide.beta)
+            (bx, by), (px, py) = xy(self.inner.local(link)[0]), xy(guide.p)
+            lines.append(((G[0] + c * (bx - px) - s * (by - py), G[1] + s * (bx - px) + c * (by - py)), u))
+            angles.append((c, s, theta))
         (G1, u1), (G2, u2) = lines
-        det = cross(u1, u2)
+        det = u1[0] * u2[1] - u1[1] * u2[0]
         ok = np.abs(det) > 1e-12
-        t1 = cross(G2 - G1, u2) / np.where(ok, det, 1.0)
-        B = G1 + t1[:, None] * u1
+        t1 = ((G2[0] - G1[0]) * u2[1] - (G2[1] - G1[1]) * u2[0]) / np.where(ok, det, 1.0)
+        B = G1[0] + t1 * u1[0], G1[1] + t1 * u1[1]
         return {
-            l1: self.place_by_point_and_angle(B, b1_loc, thetas[0]),
-            l2: self.place_by_point_and_angle(B, b2_loc, thetas[1]),
+            l1: self.place_by_point_and_angle(B, self.inner.local(l1)[0], *angles[0]),
+            l2: self.place_by_point_and_angle(B, self.inner.local(l2)[0], *angles[1]),
         }, ok
 
     def assembly_failure(self, poses):

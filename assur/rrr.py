@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .base import perp
 from .dyad import Dyad
+from .rows import xy
 
 __all__ = ["RRR"]
 
@@ -20,41 +20,45 @@ class RRR(Dyad):
     branches = (1, -1)
     slider_roles: dict[str, str] = {}
 
-    def _position(self, poses, branch):
+    def _lengths(self):
+        """``(|AB|, |CB|)`` in L1 and L2 (floats, or ``(N,)`` for a batch of variants)."""
         l1, l2 = self.links
-        a_loc, _, _ = self.ext1.local(l1)
-        c_loc, _, _ = self.ext2.local(l2)
-        b1_loc, _, _ = self.inner.local(l1)
-        b2_loc, _, _ = self.inner.local(l2)
-        A = self.known_point(poses, self.ext1, l1)
-        C = self.known_point(poses, self.ext2, l2)
-        len1 = np.hypot(*np.subtract(b1_loc, a_loc))
-        len2 = np.hypot(*np.subtract(b2_loc, c_loc))
-        d = np.linalg.norm(C - A, axis=1)
+        (ax, ay), (bx, by) = xy(self.ext1.local(l1)[0]), xy(self.inner.local(l1)[0])
+        (cx, cy), (dx, dy) = xy(self.ext2.local(l2)[0]), xy(self.inner.local(l2)[0])
+        return np.hypot(bx - ax, by - ay), np.hypot(dx - cx, dy - cy)
+
+    def _place(self, frames, branch):
+        l1, l2 = self.links
+        len1, len2 = self._lengths()
+        A = self.known_point(frames, self.ext1, l1)
+        C = self.known_point(frames, self.ext2, l2)
+        dx, dy = C[0] - A[0], C[1] - A[1]
+        d = np.hypot(dx, dy)
         ok = d > 1e-12 * self.size
         d_safe = np.where(ok, d, 1.0)
-        e = (C - A) / d_safe[:, None]
-        a = (len1**2 - len2**2 + d_safe**2) / (2 * d_safe)
-        h2 = len1**2 - a**2
+        ex, ey = dx / d_safe, dy / d_safe
+        a = (len1 * len1 - len2 * len2 + d_safe * d_safe) / (2 * d_safe)
+        h2 = len1 * len1 - a * a
         h2 = np.where((h2 < 0) & (h2 > -(1e-12 * self.size) ** 2), 0.0, h2)
         ok &= h2 >= 0
-        h = np.sqrt(np.where(ok, h2, 0.0))
-        B = A + a[:, None] * e + branch * h[:, None] * perp(e)
+        h = branch * np.sqrt(np.where(ok, h2, 0.0))
+        B = A[0] + a * ex - h * ey, A[1] + a * ey + h * ex
         return {
-            l1: self.place_by_two_points(A, B, a_loc, b1_loc),
-            l2: self.place_by_two_points(C, B, c_loc, b2_loc),
+            l1: self.place_by_two_points(A, B, self.ext1.local(l1)[0], self.inner.local(l1)[0], len1),
+            l2: self.place_by_two_points(C, B, self.ext2.local(l2)[0], self.inner.local(l2)[0], len2),
         }, ok
 
     def assembly_failure(self, poses):
         l1, l2 = self.links
         a, c, b = self.ext1.name, self.ext2.name, self.inner.name
-        d = np.linalg.norm(self.known_point(poses, self.ext2, l2) - self.known_point(poses, self.ext1, l1), axis=1)
-        len1 = np.hypot(*np.subtract(self.inner.local(l1)[0], self.ext1.local(l1)[0]))
-        len2 = np.hypot(*np.subtract(self.inner.local(l2)[0], self.ext2.local(l2)[0]))
-        if np.min(d) > len1 + len2:
+        frames = self._frames(poses)
+        A, C = self.known_point(frames, self.ext1, l1), self.known_point(frames, self.ext2, l2)
+        d = np.hypot(C[0] - A[0], C[1] - A[1])
+        len1, len2 = self._lengths()
+        if np.min(d) > np.max(len1 + len2):
             return (f"|{a}{c}| >= {np.min(d):.6g} m at every angle but {a}{b} + {c}{b} = "
-                    f"{len1 + len2:.6g} m")
-        if np.max(d) < abs(len1 - len2):
+                    f"{np.max(len1 + len2):.6g} m")
+        if np.max(d) < np.min(np.abs(len1 - len2)):
             return (f"|{a}{c}| <= {np.max(d):.6g} m at every angle but |{a}{b} - {c}{b}| = "
-                    f"{abs(len1 - len2):.6g} m")
+                    f"{np.min(np.abs(len1 - len2)):.6g} m")
         return None

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import minimize_scalar
 
-from assur.base import Group, GroupPosition, global_point
+from assur.base import Group, GroupSolution, global_point
 
 from .errors import SchemeError
 from .model import Mechanism
@@ -89,24 +89,35 @@ class BranchPlan:
         return self.mode == "keep" or int(np.sum(self.swaps)) % 2 == 0
 
 
-def place_group(group: Group, poses, branches: np.ndarray, input_error=0.0) -> GroupPosition:
-    """:meth:`Group.position` with a branch per position (each branch solved where it is used)."""
+def place_group(group: Group, poses, branches: np.ndarray, input_error=0.0, first=None, second=None,
+                frames=None) -> GroupSolution:
+    """:meth:`Group.solve` with a branch per position (each branch solved where it is used).
+
+    ``first`` / ``second``: analogs of the known links (``None``: positions only); ``frames``:
+    the known links' frames shared between groups (see :meth:`assur.dyad.Dyad.solve`).
+    """
+    extra = {} if frames is None else {"frames": frames}
     values = np.unique(branches)
     if len(values) == 1:
-        return group.position(poses, int(values[0]), input_error)
-    parts = {int(b): group.position(poses, int(b), input_error) for b in values}
+        return group.solve(poses, first, second, int(values[0]), input_error, **extra)
+    parts = {int(b): group.solve(poses, first, second, int(b), input_error) for b in values}
 
     def pick(get):
         out = get(parts[int(values[0])])
+        if out is None:
+            return None
         for b in values[1:]:
             mask = branches == b
             out = np.where(mask[:, None] if out.ndim == 2 else mask, get(parts[int(b)]), out)
         return out
 
-    first = parts[int(values[0])]
-    return GroupPosition({k: pick(lambda p, k=k: p.poses[k]) for k in first.poses},
-                         pick(lambda p: p.status), pick(lambda p: p.jacobian_sign),
-                         pick(lambda p: p.conditioning), pick(lambda p: p.error_bound))
+    def links(get):
+        one = get(parts[int(values[0])])
+        return None if one is None else {k: pick(lambda p, k=k: get(p)[k]) for k in one}
+
+    return GroupSolution(links(lambda p: p.poses), pick(lambda p: p.status), pick(lambda p: p.jacobian_sign),
+                         pick(lambda p: p.conditioning), pick(lambda p: p.error_bound),
+                         links(lambda p: p.first), links(lambda p: p.second))
 
 
 # ----------------------------------------------------------------------------------------------
@@ -128,7 +139,7 @@ def assembly_plans(mech: Mechanism) -> tuple[BranchPlan, ...]:
         group can be assembled at no input angle (the message names the group and the
         dimensional reason).
     """
-    from .kinematics import _cache, _input_state, structure_of
+    from .kinematics import _cache, input_poses, structure_of
 
     cache = _cache(mech)
     if "plans" in cache:
@@ -139,7 +150,7 @@ def assembly_plans(mech: Mechanism) -> tuple[BranchPlan, ...]:
         phi = np.linspace(0.0, TWO_PI, BRANCH_SWEEP, endpoint=False)
     else:  # an input that does not turn fully: conditions and change points within its range
         phi = np.linspace(*mech.input_range, BRANCH_SWEEP)
-    poses, _, _ = _input_state(mech, structure, phi, 0)
+    poses = input_poses(mech, structure, phi)
     plans: list[BranchPlan] = []
     for i, group in enumerate(structure.groups):
         rule = rules.get(i)
@@ -253,9 +264,9 @@ def _rule_score(mech: Mechanism, rule, poses) -> np.ndarray:
 
 def _chain(mech, structure, plans, i, phi):
     """Poses of the known links of group ``i`` at the angles ``phi`` (earlier groups placed)."""
-    from .kinematics import _input_state
+    from .kinematics import input_poses
 
-    poses, _, _ = _input_state(mech, structure, phi, 0)
+    poses = input_poses(mech, structure, phi)
     for j in structure.needed_groups(structure.groups[i].known_links):
         poses.update(place_group(structure.groups[j], poses, plans[j].branches(phi)).poses)
     return poses

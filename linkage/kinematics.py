@@ -21,7 +21,7 @@ from typing import Iterable, Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
-from assur.base import ANALOG_TOL, CANNOT_ASSEMBLE, OK, SINGULAR, global_point, perp, point_analogs, rotate
+from assur.base import ANALOG_TOL, CANNOT_ASSEMBLE, OK, SINGULAR, global_point, point_analogs
 
 from .assembly import assembly_branches, assembly_plans, place_group
 from .errors import AssemblyError, InputError, StructureError
@@ -324,41 +324,24 @@ def analyze(
     plans = assembly_plans(mech)
     group_ids = range(len(structure.groups)) if outputs is None else \
         structure.needed_groups(_links_of(mech, outputs))
-    poses, first, second = _input_state(mech, structure, phi, order)
-    status = np.full(len(phi), OK)
-    error = {link: np.zeros(len(phi)) for link in poses}   # relative error of each link's analogs
-    conditioning = {}
+    run = _run_blocks(mech, structure, plans, list(group_ids), phi, order)
     for i in group_ids:
         group = structure.groups[i]
-        incoming = np.max([error[k] for k in group.known_links], axis=0)
-        branches = plans[i].branches(phi)
-        placed = place_group(group, poses, branches, incoming)
-        poses.update(placed.poses)
-        error.update({link: placed.error_bound for link in group.links})
-        conditioning[repr(group)] = placed.conditioning
-        status = np.where(status == OK, placed.status, status)
-        _check_continuity(group, placed, branches, phi)
+        _check_continuity(group, run.signs[i], plans[i].branches(phi), run.solved[i], phi)
         _check_change_points(group, plans[i], phi)
         if order >= 1:
-            d1, d2 = group.analogs(poses, first, second, valid=placed.status == OK)
-            first.update(d1)
-            if second is not None:
-                second.update(d2)
-            _check_jumps(group, plans[i], poses, first, placed.status, phi)
-    bad = status != OK
-    for d in (first, second):
-        if d is not None and bad.any():
-            for k in d:
-                d[k] = np.where(bad[:, None], np.nan, d[k])
+            _check_jumps(group, plans[i], run.poses, run.first, run.solved[i], phi)
+    status, bad = run.status, run.status != OK
     if on_failure == "raise" and bad.any():
-        raise AssemblyError(_failure_message(mech, phi, status, conditioning), np.degrees(phi[bad]))
+        raise AssemblyError(_failure_message(mech, phi, status, run.conditioning), np.degrees(phi[bad]))
+    poses, first, second = run.poses, run.first, run.second
     omega_arr = eps_arr = None
     if omega is not None:
         omega_arr = np.broadcast_to(np.asarray(omega, dtype=float), phi.shape).copy()
         eps_arr = np.broadcast_to(np.asarray(0.0 if eps is None else eps, dtype=float), phi.shape).copy()
     return Motion(mech, structure, phi, poses, first if order >= 1 else None,
-                  second if order >= 2 else None, status, omega_arr, eps_arr, conditioning,
-                  np.max(list(error.values()), axis=0))
+                  second if order >= 2 else None, status, omega_arr, eps_arr, run.conditioning,
+                  run.error_bound)
 
 
 def input_sweep(mech: Mechanism) -> Motion:
@@ -389,24 +372,113 @@ def _links_of(mech: Mechanism, outputs: Iterable[str]) -> list[str]:
     return links
 
 
-def _input_state(mech: Mechanism, structure: Structure, phi: np.ndarray, order: int):
-    """Poses and analogs of the frame and the input link at the angles ``phi``."""
+#: positions solved at a time: the temporaries of a block stay in the processor's cache and the
+#: memory of a call stays bounded (the result plus a few blocks)
+BLOCK = 8192
+
+
+@dataclass
+class _Run:
+    """What :func:`_run_blocks` computed, over all N positions."""
+
+    poses: dict[str, np.ndarray]
+    first: dict[str, np.ndarray] | None
+    second: dict[str, np.ndarray] | None
+    status: np.ndarray
+    conditioning: dict[str, np.ndarray]
+    error_bound: np.ndarray
+    signs: dict[int, np.ndarray]     # group index -> sign of its Jacobian determinant (N,)
+    solved: dict[int, np.ndarray]    # group index -> the group's own status (N,)
+
+
+def _run_blocks(mech: Mechanism, structure: Structure, plans, group_ids: list[int], phi: np.ndarray,
+                order: int) -> _Run:
+    """Solve the groups ``group_ids`` in order at the angles ``phi``, :data:`BLOCK` positions at a
+    time, into arrays allocated once (links' values in columns of ``(N, 3)`` arrays)."""
     N = len(phi)
-    zeros = np.zeros((N, 3))
-    poses = {mech.frame: zeros.copy()}
-    first = {mech.frame: zeros.copy()} if order >= 1 else None
-    second = {mech.frame: zeros.copy()} if order >= 2 else None
+    links = [mech.frame, *structure.inputs] + [k for i in group_ids for k in structure.groups[i].links]
+
+    def allocate():
+        return {k: np.empty((3, N)).T for k in links}
+
+    poses = allocate()
+    first = allocate() if order >= 1 else None
+    second = allocate() if order >= 2 else None
+    status = np.full(N, OK)
+    error = np.zeros(N)
+    conditioning = {repr(structure.groups[i]): np.empty(N) for i in group_ids}
+    signs = {i: np.empty(N) for i in group_ids}
+    solved = {i: np.empty(N, dtype=int) for i in group_ids}
+    branches = {i: plans[i].branches(phi) for i in group_ids}
+    for start in range(0, max(N, 1), BLOCK):
+        block = slice(start, min(start + BLOCK, N))
+        view = {k: v[block] for k, v in poses.items()}
+        view1 = None if first is None else {k: v[block] for k, v in first.items()}
+        view2 = None if second is None else {k: v[block] for k, v in second.items()}
+        _input_state(mech, structure, phi[block], view, view1, view2)
+        link_error = {k: 0.0 for k in view}
+        frames: dict = {}
+        for i in group_ids:
+            group = structure.groups[i]
+            incoming = _largest([link_error[k] for k in group.known_links])
+            got = place_group(group, view, branches[i][block], incoming, view1, view2, frames)
+            for k in group.links:
+                view[k][...] = got.poses[k]
+                if view1 is not None:
+                    view1[k][...] = got.first[k]
+                if view2 is not None:
+                    view2[k][...] = got.second[k]
+                link_error[k] = got.error_bound
+            conditioning[repr(group)][block] = got.conditioning
+            signs[i][block] = got.jacobian_sign
+            solved[i][block] = got.status
+            status[block] = np.where(status[block] == OK, got.status, status[block])
+        error[block] = _largest(list(link_error.values()))
+        bad = status[block] != OK
+        if bad.any():
+            for analogs in (view1, view2):
+                for v in (analogs or {}).values():
+                    v[bad] = np.nan
+    return _Run(poses, first, second, status, conditioning, error, signs, solved)
+
+
+def _largest(values: list) -> np.ndarray | float:
+    """Elementwise maximum of scalars and arrays (0 for none)."""
+    out = 0.0
+    for v in values:
+        out = np.maximum(out, v)
+    return out
+
+
+def _input_state(mech: Mechanism, structure: Structure, phi: np.ndarray, poses: dict, first: dict | None = None,
+                 second: dict | None = None) -> None:
+    """Write the poses and analogs of the frame and the input link at the angles ``phi`` into the
+    ``(N, 3)`` arrays of ``poses`` / ``first`` / ``second`` (allocated when missing)."""
+    N = len(phi)
+    for d in (poses, first, second):
+        if d is not None:
+            for link in (mech.frame, *structure.inputs):
+                if link not in d:
+                    d[link] = np.empty((N, 3))
+            d[mech.frame][...] = 0.0
     for name in structure.inputs:
         joint = structure.input_joints[name]
         p_input, _, p_frame = joint.local(name)
-        pivot = np.asarray(p_frame, dtype=float)  # the frame's pose is the identity
-        rho = rotate(phi, p_input)
-        poses[name] = np.column_stack([pivot - rho, phi])
+        c, s = np.cos(phi), np.sin(phi)
+        rx, ry = c * p_input[0] - s * p_input[1], s * p_input[0] + c * p_input[1]
+        out = poses[name]
+        out[:, 0], out[:, 1], out[:, 2] = p_frame[0] - rx, p_frame[1] - ry, phi
         if first is not None:
-            first[name] = np.column_stack([-perp(rho), np.ones(N)])
+            first[name][:, 0], first[name][:, 1], first[name][:, 2] = ry, -rx, 1.0
         if second is not None:
-            second[name] = np.column_stack([rho, np.zeros(N)])
-    return poses, first, second
+            second[name][:, 0], second[name][:, 1], second[name][:, 2] = rx, ry, 0.0
+
+
+def input_poses(mech: Mechanism, structure: Structure, phi: np.ndarray) -> dict[str, np.ndarray]:
+    """Poses ``(N, 3)`` of the frame and the input link at the angles ``phi``."""
+    poses: dict[str, np.ndarray] = {}
+    _input_state(mech, structure, phi, poses)
+    return poses
 
 
 def _failure_message(mech: Mechanism, phi: np.ndarray, status: np.ndarray, conditioning: dict) -> str:
@@ -428,11 +500,11 @@ def _failure_message(mech: Mechanism, phi: np.ndarray, status: np.ndarray, condi
             + " (use on_failure='mask' to get a per-position status instead)")
 
 
-def _check_continuity(group, placed, branches, phi) -> None:
+def _check_continuity(group, sign: np.ndarray, branches: np.ndarray, solved: np.ndarray, phi) -> None:
     """Warn when the group's Jacobian determinant changes sign (relative to the branch in use)
     between positions: the group passes a singular position between analysed angles."""
-    ok = placed.status == OK
-    signs = (placed.jacobian_sign * branches)[ok]
+    ok = solved == OK
+    signs = (sign * branches)[ok]
     if len(signs) and np.any(signs != signs[0]):
         changed = np.degrees(phi[ok][signs != signs[0]])
         warnings.warn(
@@ -470,7 +542,9 @@ def _check_jumps(group, plan, poses, first, status, phi) -> None:
     """Warn where a group moves between two analysed angles (at most 10 deg apart) by more than
     its first analogs allow: the displacement of points fixed in its links differs from the
     trapezoid rule on their analogs by more than half of either (a change point or a singular
-    position passed between the angles, with no other warning)."""
+    position passed between the angles, with no other warning). The points: each link's local
+    origin and the points one group scale along its local axes. Checked :data:`BLOCK` steps at
+    a time."""
     if len(phi) < 2:
         return
     dphi = np.diff(phi)
@@ -479,20 +553,16 @@ def _check_jumps(group, plan, poses, first, status, phi) -> None:
         pairs &= ~plan.crossed(phi).any(axis=0)
     if not pairs.any():
         return
-    scale = float(np.nanmedian(group.scale(poses)))
-    moved, allowed = [], []
-    for link in group.links:
-        origin = np.zeros(2)
-        for local in (origin, origin + (scale, 0.0), origin + (0.0, scale)):
-            p = global_point(poses[link], local)
-            d1, _ = point_analogs(poses[link], first[link], None, local)
-            moved.append(np.diff(p, axis=0))
-            allowed.append(0.5 * (d1[:-1] + d1[1:]) * dphi[:, None])
-    moved, allowed = np.concatenate(moved, axis=1), np.concatenate(allowed, axis=1)
-    miss = np.linalg.norm(moved - allowed, axis=1)
-    reference = np.linalg.norm(moved, axis=1) + np.linalg.norm(allowed, axis=1)
-    with np.errstate(invalid="ignore"):
-        bad = pairs & (miss > 0.5 * reference) & (miss > 1e-9 * scale)
+    sample = np.flatnonzero(status == OK)
+    sample = sample[:: max(1, len(sample) // 4096)]
+    scale = float(np.median(group.scale({k: v[sample] for k, v in poses.items()})))
+    bad = np.zeros(len(dphi), bool)
+    for start in range(0, len(dphi), BLOCK):
+        steps = slice(start, min(start + BLOCK, len(dphi)))
+        if pairs[steps].any():
+            ends = slice(steps.start, steps.stop + 1)
+            bad[steps] = _jumps({k: poses[k][ends] for k in group.links}, {k: first[k][ends] for k in group.links},
+                                dphi[steps], scale) & pairs[steps]
     if bad.any():
         k = np.flatnonzero(bad)
         shown = ", ".join(f"{np.degrees(phi[j]):.6g}..{np.degrees(phi[j + 1]):.6g}" for j in k[:5])
@@ -500,3 +570,24 @@ def _check_jumps(group, plan, poses, first, status, phi) -> None:
             f"group {group!r} moves between the input angles {shown} deg more than its analogs "
             "allow: it passes a change point or a singular position between them (analyse finer "
             "angles there)", BranchWarning, stacklevel=3)
+
+
+def _jumps(poses: dict, first: dict, dphi: np.ndarray, scale: float) -> np.ndarray:
+    """For M + 1 positions: ``(M,)`` whether each step moves more than the trapezoid rule on the
+    first analogs allows (see :func:`_check_jumps`)."""
+    miss2 = moved2 = allowed2 = 0.0
+    for link, pose in poses.items():
+        c, s = scale * np.cos(pose[:, 2]), scale * np.sin(pose[:, 2])
+        x, y, w = pose[:, 0], pose[:, 1], first[link][:, 2]
+        vx, vy = first[link][:, 0], first[link][:, 1]
+        # the three points and their first analogs: origin, origin + scale * (e_x, e_y)
+        for px, py, dx, dy in ((x, y, vx, vy), (x + c, y + s, vx - w * s, vy + w * c),
+                               (x - s, y + c, vx - w * c, vy - w * s)):
+            mx, my = np.diff(px), np.diff(py)
+            ax, ay = 0.5 * (dx[:-1] + dx[1:]) * dphi, 0.5 * (dy[:-1] + dy[1:]) * dphi
+            miss2 = miss2 + (mx - ax) ** 2 + (my - ay) ** 2
+            moved2 = moved2 + mx * mx + my * my
+            allowed2 = allowed2 + ax * ax + ay * ay
+    miss = np.sqrt(miss2)
+    with np.errstate(invalid="ignore"):
+        return (miss > 0.5 * (np.sqrt(moved2) + np.sqrt(allowed2))) & (miss > 1e-9 * scale)
