@@ -460,17 +460,23 @@ class Group(ABC):
         return d1, self._split(q2)
 
     def solve(self, poses: Poses, first: Poses | None = None, second: Poses | None = None, branch: int = 1,
-              input_error=0.0) -> GroupSolution:
+              input_error=0.0, frames=None, out=None) -> GroupSolution:
         """Positions, statuses and analogs in one call: :meth:`position` then :meth:`analogs`.
 
         ``first`` (and ``second``) are the analogs of the known links; without them only
-        positions are solved. Kinds with a fast path (the dyads) override this with the same
-        results computed elementwise; this generic version is their oracle.
+        positions are solved. ``out``: ``(poses, first, second)``, dicts of ``(N, 3)`` arrays
+        (or None) that receive the group's results. ``frames`` (a cache of link frames shared
+        by the fast paths) is not used here. Kinds with a fast path (the dyads) override this
+        with the same results computed elementwise; this generic version is their oracle.
         """
         placed = self.position(poses, branch, input_error)
         d1 = d2 = None
         if first is not None:
             d1, d2 = self.analogs({**poses, **placed.poses}, first, second, valid=placed.status == OK)
+        if out is not None:
+            for into, got in zip(out, (placed.poses, d1, d2)):
+                for link, value in (got or {}).items():
+                    into[link][...] = value
         return GroupSolution(placed.poses, placed.status, placed.jacobian_sign, placed.conditioning,
                              placed.error_bound, d1, d2)
 

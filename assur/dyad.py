@@ -53,14 +53,16 @@ class Dyad(Group):
 
     # -- the fast path ------------------------------------------------------------------------
     def solve(self, poses, first=None, second=None, branch: int = 1, input_error=0.0,
-              frames=None) -> GroupSolution:
+              frames=None, out=None) -> GroupSolution:
         """:meth:`Group.solve` in closed form: the same statuses, conditioning, bounds and analogs.
 
         The six unknowns of the analog systems are eliminated pair by pair: each external pair
         fixes its link's velocity up to one parameter along the null vector of its two rows, and
         the inner pair's two rows give those two parameters (a 2x2 system whose determinant is
         the determinant of the group Jacobian). ``frames`` may carry the known links' frames
-        (:func:`assur.rows.frame`) computed once for every group that uses them.
+        (:func:`assur.rows.frame`) computed once for every group that uses them; it receives the
+        group's own frames. ``out``: ``(poses, first, second)`` dicts of ``(N, 3)`` arrays to write
+        the group's results into (see :meth:`Group.solve`).
         """
         if branch not in self.branches:
             raise ValueError(f"{self!r}: branch must be one of {self.branches}, got {branch!r}")
@@ -87,7 +89,8 @@ class Dyad(Group):
         if not assembled.all():    # later groups see NaN where this one is not assembled
             placed = {k: tuple(np.where(assembled, c, np.nan) for c in f) for k, f in placed.items()}
             frames.update(placed)
-        new = {k: _pose_array((f[0], f[1], f[4]), ~assembled) for k, f in placed.items()}
+        into = (None, None, None) if out is None else out
+        new = {k: _pose_array((f[0], f[1], f[4]), ~assembled, into[0], k) for k, f in placed.items()}
         d1 = d2 = None
         if first is not None:
             bad = status != OK
@@ -95,13 +98,13 @@ class Dyad(Group):
                 det_safe = np.where(bad, 1.0, det)
                 known = {k: _columns(first[k]) for k in self.known_links}
                 q1, q2 = self._eliminate(rows, known, None, det_safe)
-                d1 = {l1: _pose_array(q1, bad), l2: _pose_array(q2, bad)}
+                d1 = {l1: _pose_array(q1, bad, into[1], l1), l2: _pose_array(q2, bad, into[1], l2)}
                 if second is not None:
                     all_first = {**known, l1: q1, l2: q2}
                     gammas = [r.quadratic(all_first) for r in rows]
                     known2 = {k: _columns(second[k]) for k in self.known_links}
                     a1, a2 = self._eliminate(rows, known2, gammas, det_safe)
-                    d2 = {l1: _pose_array(a1, bad), l2: _pose_array(a2, bad)}
+                    d2 = {l1: _pose_array(a1, bad, into[2], l1), l2: _pose_array(a2, bad, into[2], l2)}
         return GroupSolution(new, status, sign, conditioning, bound, d1, d2)
 
     def _eliminate(self, rows, known, gammas, det):
@@ -218,12 +221,13 @@ def _columns(q: np.ndarray):
     return q[:, 0], q[:, 1], q[:, 2]
 
 
-def _pose_array(q, bad: np.ndarray) -> np.ndarray:
-    """Three columns as an ``(N, 3)`` array, NaN at the positions ``bad``."""
-    out = np.empty((len(bad), 3))
+def _pose_array(q, bad: np.ndarray, into: dict | None = None, link: str | None = None) -> np.ndarray:
+    """Three columns as an ``(N, 3)`` array (``into[link]`` when given), NaN at the positions ``bad``."""
+    out = np.empty((len(bad), 3)) if into is None else into[link]
     for i, column in enumerate(q):
         out[:, i] = column
-    out[bad] = np.nan
+    if bad.any():
+        out[bad] = np.nan
     return out
 
 

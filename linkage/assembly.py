@@ -89,17 +89,17 @@ class BranchPlan:
         return self.mode == "keep" or int(np.sum(self.swaps)) % 2 == 0
 
 
-def place_group(group: Group, poses, branches: np.ndarray, input_error=0.0, first=None, second=None,
-                frames=None) -> GroupSolution:
-    """:meth:`Group.solve` with a branch per position (each branch solved where it is used).
+def place_group(group: Group, poses, branches, input_error=0.0, first=None, second=None,
+                frames=None, out=None) -> GroupSolution:
+    """:meth:`Group.solve` with a branch per position ``(N,)`` (each branch solved where it is
+    used), or one branch (int) for all.
 
-    ``first`` / ``second``: analogs of the known links (``None``: positions only); ``frames``:
-    the known links' frames shared between groups (see :meth:`assur.dyad.Dyad.solve`).
+    ``first`` / ``second``: analogs of the known links (``None``: positions only); ``frames`` and
+    ``out``: see :meth:`assur.base.Group.solve`.
     """
-    extra = {} if frames is None else {"frames": frames}
     values = np.unique(branches)
     if len(values) == 1:
-        return group.solve(poses, first, second, int(values[0]), input_error, **extra)
+        return group.solve(poses, first, second, int(values[0]), input_error, frames=frames, out=out)
     parts = {int(b): group.solve(poses, first, second, int(b), input_error) for b in values}
 
     def pick(get):
@@ -115,9 +115,16 @@ def place_group(group: Group, poses, branches: np.ndarray, input_error=0.0, firs
         one = get(parts[int(values[0])])
         return None if one is None else {k: pick(lambda p, k=k: get(p)[k]) for k in one}
 
-    return GroupSolution(links(lambda p: p.poses), pick(lambda p: p.status), pick(lambda p: p.jacobian_sign),
-                         pick(lambda p: p.conditioning), pick(lambda p: p.error_bound),
-                         links(lambda p: p.first), links(lambda p: p.second))
+    solved = GroupSolution(links(lambda p: p.poses), pick(lambda p: p.status), pick(lambda p: p.jacobian_sign),
+                           pick(lambda p: p.conditioning), pick(lambda p: p.error_bound),
+                           links(lambda p: p.first), links(lambda p: p.second))
+    if out is not None:
+        for into, got in zip(out, (solved.poses, solved.first, solved.second)):
+            for link, value in (got or {}).items():
+                into[link][...] = value
+    if frames is not None:
+        frames.clear()     # the parts' frames are not kept: the next groups recompute theirs
+    return solved
 
 
 # ----------------------------------------------------------------------------------------------

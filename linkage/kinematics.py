@@ -399,7 +399,8 @@ def _run_blocks(mech: Mechanism, structure: Structure, plans, group_ids: list[in
     links = [mech.frame, *structure.inputs] + [k for i in group_ids for k in structure.groups[i].links]
 
     def allocate():
-        return {k: np.empty((3, N)).T for k in links}
+        # the frame's values are zeros that are never written (pages the system maps lazily)
+        return {k: (np.zeros if k == mech.frame else np.empty)((3, N)).T for k in links}
 
     poses = allocate()
     first = allocate() if order >= 1 else None
@@ -409,25 +410,23 @@ def _run_blocks(mech: Mechanism, structure: Structure, plans, group_ids: list[in
     conditioning = {repr(structure.groups[i]): np.empty(N) for i in group_ids}
     signs = {i: np.empty(N) for i in group_ids}
     solved = {i: np.empty(N, dtype=int) for i in group_ids}
-    branches = {i: plans[i].branches(phi) for i in group_ids}
+    branches = {}
+    for i in group_ids:
+        per_position = plans[i].branches(phi)
+        branches[i] = int(per_position[0]) if len(phi) and np.all(per_position == per_position[0]) else per_position
     for start in range(0, max(N, 1), BLOCK):
         block = slice(start, min(start + BLOCK, N))
         view = {k: v[block] for k, v in poses.items()}
         view1 = None if first is None else {k: v[block] for k, v in first.items()}
         view2 = None if second is None else {k: v[block] for k, v in second.items()}
-        _input_state(mech, structure, phi[block], view, view1, view2)
+        frames = _input_state(mech, structure, phi[block], view, view1, view2)
         link_error = {k: 0.0 for k in view}
-        frames: dict = {}
         for i in group_ids:
             group = structure.groups[i]
             incoming = _largest([link_error[k] for k in group.known_links])
-            got = place_group(group, view, branches[i][block], incoming, view1, view2, frames)
+            branch = branches[i] if isinstance(branches[i], int) else branches[i][block]
+            got = place_group(group, view, branch, incoming, view1, view2, frames, (view, view1, view2))
             for k in group.links:
-                view[k][...] = got.poses[k]
-                if view1 is not None:
-                    view1[k][...] = got.first[k]
-                if view2 is not None:
-                    view2[k][...] = got.second[k]
                 link_error[k] = got.error_bound
             conditioning[repr(group)][block] = got.conditioning
             signs[i][block] = got.jacobian_sign
@@ -451,27 +450,33 @@ def _largest(values: list) -> np.ndarray | float:
 
 
 def _input_state(mech: Mechanism, structure: Structure, phi: np.ndarray, poses: dict, first: dict | None = None,
-                 second: dict | None = None) -> None:
-    """Write the poses and analogs of the frame and the input link at the angles ``phi`` into the
-    ``(N, 3)`` arrays of ``poses`` / ``first`` / ``second`` (allocated when missing)."""
+                 second: dict | None = None) -> dict:
+    """Write the poses and analogs of the input link at the angles ``phi`` into the ``(N, 3)``
+    arrays of ``poses`` / ``first`` / ``second`` (the frame's are zeros; arrays are allocated
+    when missing). Returns the frames ``(x, y, c, s, theta)`` of the frame and the input link."""
     N = len(phi)
     for d in (poses, first, second):
         if d is not None:
-            for link in (mech.frame, *structure.inputs):
+            if mech.frame not in d:
+                d[mech.frame] = np.zeros((N, 3))
+            for link in structure.inputs:
                 if link not in d:
                     d[link] = np.empty((N, 3))
-            d[mech.frame][...] = 0.0
+    zeros = np.zeros(N)
+    frames = {mech.frame: (zeros, zeros, np.ones(N), zeros, zeros)}
+    c, s = np.cos(phi), np.sin(phi)
     for name in structure.inputs:
         joint = structure.input_joints[name]
         p_input, _, p_frame = joint.local(name)
-        c, s = np.cos(phi), np.sin(phi)
         rx, ry = c * p_input[0] - s * p_input[1], s * p_input[0] + c * p_input[1]
         out = poses[name]
         out[:, 0], out[:, 1], out[:, 2] = p_frame[0] - rx, p_frame[1] - ry, phi
+        frames[name] = (out[:, 0], out[:, 1], c, s, out[:, 2])
         if first is not None:
             first[name][:, 0], first[name][:, 1], first[name][:, 2] = ry, -rx, 1.0
         if second is not None:
             second[name][:, 0], second[name][:, 1], second[name][:, 2] = rx, ry, 0.0
+    return frames
 
 
 def input_poses(mech: Mechanism, structure: Structure, phi: np.ndarray) -> dict[str, np.ndarray]:
@@ -542,8 +547,7 @@ def _check_jumps(group, plan, poses, first, status, phi) -> None:
     """Warn where a group moves between two analysed angles (at most 10 deg apart) by more than
     its first analogs allow: the displacement of points fixed in its links differs from the
     trapezoid rule on their analogs by more than half of either (a change point or a singular
-    position passed between the angles, with no other warning). The points: each link's local
-    origin and the points one group scale along its local axes. Checked :data:`BLOCK` steps at
+    position passed between the angles, with no other warning). Checked :data:`BLOCK` steps at
     a time."""
     if len(phi) < 2:
         return
@@ -574,20 +578,20 @@ def _check_jumps(group, plan, poses, first, status, phi) -> None:
 
 def _jumps(poses: dict, first: dict, dphi: np.ndarray, scale: float) -> np.ndarray:
     """For M + 1 positions: ``(M,)`` whether each step moves more than the trapezoid rule on the
-    first analogs allows (see :func:`_check_jumps`)."""
+    first analogs allows (see :func:`_check_jumps`). A link's move is the displacement of its
+    origin and its turn times ``scale``, the turn taken in (-pi, pi]."""
     miss2 = moved2 = allowed2 = 0.0
     for link, pose in poses.items():
-        c, s = scale * np.cos(pose[:, 2]), scale * np.sin(pose[:, 2])
-        x, y, w = pose[:, 0], pose[:, 1], first[link][:, 2]
-        vx, vy = first[link][:, 0], first[link][:, 1]
-        # the three points and their first analogs: origin, origin + scale * (e_x, e_y)
-        for px, py, dx, dy in ((x, y, vx, vy), (x + c, y + s, vx - w * s, vy + w * c),
-                               (x - s, y + c, vx - w * c, vy - w * s)):
-            mx, my = np.diff(px), np.diff(py)
-            ax, ay = 0.5 * (dx[:-1] + dx[1:]) * dphi, 0.5 * (dy[:-1] + dy[1:]) * dphi
-            miss2 = miss2 + (mx - ax) ** 2 + (my - ay) ** 2
-            moved2 = moved2 + mx * mx + my * my
-            allowed2 = allowed2 + ax * ax + ay * ay
+        for k, weight in ((0, 1.0), (1, 1.0), (2, scale)):
+            moved = np.diff(pose[:, k])
+            if k == 2:
+                moved = (moved + np.pi) % (2 * np.pi) - np.pi
+            moved *= weight
+            d = first[link][:, k]
+            allowed = (0.5 * weight) * (d[:-1] + d[1:]) * dphi
+            miss2 = miss2 + (moved - allowed) ** 2
+            moved2 = moved2 + moved * moved
+            allowed2 = allowed2 + allowed * allowed
     miss = np.sqrt(miss2)
     with np.errstate(invalid="ignore"):
         return (miss > 0.5 * (np.sqrt(moved2) + np.sqrt(allowed2))) & (miss > 1e-9 * scale)
