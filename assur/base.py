@@ -285,7 +285,7 @@ class Group(ABC):
     def __init__(self, links: Sequence[str], joints: Sequence[Joint], size: float = 1.0):
         self.links = tuple(links)
         self.joints = tuple(joints)
-        self.size = float(size)
+        self.size = float(size) if np.ndim(size) == 0 else np.asarray(size, dtype=float)
         self.known_links = tuple(sorted(({j.a for j in joints} | {j.b for j in joints}) - set(links)))
 
     # -- binding -------------------------------------------------------------------------------

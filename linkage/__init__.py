@@ -9,6 +9,7 @@ transfer functions (:mod:`linkage.kinematics`).
 from .errors import AssemblyError, InputError, LinkageError, SchemeError, StructureError
 from .extremes import extreme_positions, table_angles
 from .kinematics import Motion, analyze, structure_of
+from .batch import VariantMotion, analyze_variants, geometry_of
 from .model import Mechanism, MechanismBuilder
 from .scheme import dumps, load, loads, save, shipped_schemes
 from .structure import decompose, mobility
@@ -16,7 +17,8 @@ from . import forces, dynamics  # noqa: F401  (register the [loads] and [dynamic
 
 __all__ = [
     "AssemblyError", "InputError", "LinkageError", "SchemeError", "StructureError", "Mechanism",
-    "MechanismBuilder", "Motion", "analyze", "decompose", "dumps", "extreme_positions", "load",
+    "MechanismBuilder", "Motion", "VariantMotion", "analyze", "analyze_variants", "decompose",
+    "geometry_of", "dumps", "extreme_positions", "load",
     "loads", "mobility", "save", "shipped_schemes", "structure_of", "table_angles",
 ]
 __version__ = "0.1.0"

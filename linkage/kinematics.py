@@ -22,14 +22,15 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from assur.base import ANALOG_TOL, CANNOT_ASSEMBLE, OK, SINGULAR, global_point, point_analogs
+from assur.rows import xy
 
 from .assembly import assembly_branches, assembly_plans, place_group
 from .errors import AssemblyError, InputError, StructureError
 from .model import Mechanism, Prismatic
 from .structure import Structure, decompose
 
-__all__ = ["Motion", "analyze", "input_sweep", "SWEEP", "structure_of", "assembly_branches", "BranchWarning", "parse_quantity",
-           "table_positions_deg", "angle_in_half_turn"]
+__all__ = ["Motion", "analyze", "input_sweep", "SWEEP", "structure_of", "assembly_branches", "BranchWarning",
+           "parse_quantity", "table_positions_deg", "angle_in_half_turn"]
 
 
 #: input angles of :func:`input_sweep` (a turn in 360 steps, both ends included, or the input range)
@@ -137,8 +138,8 @@ class Motion:
                                    self.second and self.second[link], local)
             return value, d1[:, axis], None if d2 is None else d2[:, axis]
         if kind == "link":
-            pick = (lambda d: None if d is None else d[obj][:, 2])
-            return self.poses[obj][:, 2], pick(self.first), pick(self.second)
+            first, second = (None if d is None else d[obj][:, 2] for d in (self.first, self.second))
+            return self.poses[obj][:, 2], first, second
         joint = self.joints[obj]
         return joint.slide(self.poses, self.first, self.second)
 
@@ -392,9 +393,12 @@ class _Run:
 
 
 def _run_blocks(mech: Mechanism, structure: Structure, plans, group_ids: list[int], phi: np.ndarray,
-                order: int) -> _Run:
+                order: int, structure_at=None) -> _Run:
     """Solve the groups ``group_ids`` in order at the angles ``phi``, :data:`BLOCK` positions at a
-    time, into arrays allocated once (links' values in columns of ``(N, 3)`` arrays)."""
+    time, into arrays allocated once (links' values in columns of ``(N, 3)`` arrays).
+
+    ``structure_at(block)``, when given, is the structure whose joints hold the geometry of the
+    positions ``block`` (a slice), for batches of design variants."""
     N = len(phi)
     links = [mech.frame, *structure.inputs] + [k for i in group_ids for k in structure.groups[i].links]
 
@@ -416,6 +420,8 @@ def _run_blocks(mech: Mechanism, structure: Structure, plans, group_ids: list[in
         branches[i] = int(per_position[0]) if len(phi) and np.all(per_position == per_position[0]) else per_position
     for start in range(0, max(N, 1), BLOCK):
         block = slice(start, min(start + BLOCK, N))
+        if structure_at is not None:
+            structure = structure_at(block)
         view = {k: v[block] for k, v in poses.items()}
         view1 = None if first is None else {k: v[block] for k, v in first.items()}
         view2 = None if second is None else {k: v[block] for k, v in second.items()}
@@ -468,9 +474,10 @@ def _input_state(mech: Mechanism, structure: Structure, phi: np.ndarray, poses: 
     for name in structure.inputs:
         joint = structure.input_joints[name]
         p_input, _, p_frame = joint.local(name)
-        rx, ry = c * p_input[0] - s * p_input[1], s * p_input[0] + c * p_input[1]
+        (px, py), (fx, fy) = xy(p_input), xy(p_frame)
+        rx, ry = c * px - s * py, s * px + c * py
         out = poses[name]
-        out[:, 0], out[:, 1], out[:, 2] = p_frame[0] - rx, p_frame[1] - ry, phi
+        out[:, 0], out[:, 1], out[:, 2] = fx - rx, fy - ry, phi
         frames[name] = (out[:, 0], out[:, 1], c, s, out[:, 2])
         if first is not None:
             first[name][:, 0], first[name][:, 1], first[name][:, 2] = ry, -rx, 1.0

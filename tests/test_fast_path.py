@@ -81,7 +81,8 @@ def test_positions_only_and_first_order_agree_with_the_full_solve(kind, data):
 def _rrr(d):
     """RRR on the frame: A = (0, 0), C = (d, 0), AB = 1, CB = 1 (B at the apex of an isosceles
     triangle): singular (stretched) at d = 2, not assembled beyond."""
-    joints = [RevoluteJoint("A", "0", "1", (0.0, 0.0), (0.0, 0.0)), RevoluteJoint("B", "1", "2", (1.0, 0.0), (1.0, 0.0)),
+    joints = [RevoluteJoint("A", "0", "1", (0.0, 0.0), (0.0, 0.0)),
+              RevoluteJoint("B", "1", "2", (1.0, 0.0), (1.0, 0.0)),
               RevoluteJoint("C", "2", "0", (0.0, 0.0), (d, 0.0))]
     return GROUP_KINDS["RRR"].bind(("1", "2"), joints, {"0"}, 2.0)
 
