@@ -44,7 +44,7 @@ The full format (every key, unit and default) is in ``schemes/README.md``.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, Mapping, Sequence
+from typing import Any, Iterable, Mapping, Sequence
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -697,24 +697,31 @@ def _per_position(value: ArrayLike, n: int, shape: tuple[int, ...], what: str) -
                          f"shape {(n, *shape)}, got shape {arr.shape}") from None
 
 
-def evaluate_loads(motion: Motion, loads: Loads, ends: ArrayLike | None = None) -> list[LoadTerm]:
+def evaluate_loads(motion: Motion, loads: Loads, ends: ArrayLike | None = None,
+                   links: Iterable[str] | None = None) -> list[LoadTerm]:
     """Gravity and external loads at the positions of ``motion`` (inertia not included).
 
     ``ends`` (bool, per position) marks positions that end a cycle: at a stroke end they take the
-    value of the stroke that ends there (docs/methods.md, "Loads").
+    value of the stroke that ends there (docs/methods.md, "Loads"). ``links``: only the loads on
+    these links (default: every moving link).
     """
     mech, n = motion.mechanism, len(motion.phi)
     rotation = 1.0 if motion.omega is None else float(np.sign(np.mean(motion.omega)) or 1.0)
     terms = []
     g = np.asarray(loads.gravity, dtype=float)
     zero = np.zeros(n)
+    wanted = set(mech.moving_links if links is None else links)
     if np.any(g != 0):
         for k in mech.moving_links:
+            if k not in wanted:
+                continue
             link = mech.links[k]
             if link.mass > 0:
                 terms.append(LoadTerm(k, link.center_of_mass, np.tile(link.mass * g, (n, 1)), zero,
                                       "gravity", f"G{k}"))
     for f in loads.forces:
+        if f.link not in wanted:
+            continue
         local = mech.links[f.link].points[f.point]
         kind = "external"
         if f.direction is not None:  # a signed magnitude along a direction of the motion
@@ -739,6 +746,8 @@ def evaluate_loads(motion: Motion, loads: Loads, ends: ArrayLike | None = None) 
             vec = _per_position(f.force, n, (2,), f"force at point '{f.point}'")
         terms.append(LoadTerm(f.link, local, vec, zero, kind, f"F{f.point}"))
     for m in loads.moments:
+        if m.link not in wanted:
+            continue
         kind = "external"
         if isinstance(m.moment, StrokeDiagram):
             value, d1, d2 = motion.quantity(m.moment.quantity)
@@ -750,10 +759,11 @@ def evaluate_loads(motion: Motion, loads: Loads, ends: ArrayLike | None = None) 
     return terms
 
 
-def inertia_terms(motion: Motion) -> list[LoadTerm]:
+def inertia_terms(motion: Motion, links: Iterable[str] | None = None) -> list[LoadTerm]:
     """Inertia forces ``-m a_S`` at the centres of mass and moments ``-J_S eps_k`` (docs/methods.md, "Kinetostatics").
 
-    Needs a motion analysed with ``omega`` (and ``eps``) and second analogs.
+    Needs a motion analysed with ``omega`` (and ``eps``) and second analogs. ``links``: only
+    these links (default: every moving link); links without mass or inertia give no term.
     """
     if motion.omega is None or motion.second is None:
         raise InputError("inertia loads need real accelerations: analyze(..., order=2, omega=..., eps=...)")
@@ -762,9 +772,10 @@ def inertia_terms(motion: Motion) -> list[LoadTerm]:
     mech = motion.mechanism
     w, e = motion.omega, motion.eps
     terms = []
+    wanted = set(mech.moving_links if links is None else links)
     for k in mech.moving_links:
         link = mech.links[k]
-        if link.mass == 0 and link.inertia == 0:
+        if k not in wanted or link.mass == 0 and link.inertia == 0:
             continue
         d1, d2 = point_analogs(motion.poses[k], motion.first[k], motion.second[k], link.center_of_mass)
         acc = d2 * (w**2)[:, None] + d1 * e[:, None]

@@ -23,6 +23,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from typing import Iterable
+
 import numpy as np
 from numpy.typing import ArrayLike
 
@@ -119,6 +121,7 @@ def solve_reactions(
     *,
     inertia: bool = True,
     ends: ArrayLike | None = None,
+    pairs: Iterable[str] | None = None,
 ) -> Reactions:
     """Reactions in every pair and the balancing moment, group by group from the farthest.
 
@@ -134,21 +137,42 @@ def solve_reactions(
         Include inertia forces and moments (needs ``motion.omega``).
     ends : array_like of bool, optional
         Positions that end a cycle (force diagrams take their end-of-stroke value there).
+    pairs : iterable of str, optional
+        Only the reactions in these pairs: the groups that place them and the groups that load
+        those (:meth:`linkage.structure.Structure.loading_groups`) are solved, and only their
+        links' loads are evaluated; the motion needs only those links (``analyze(...,
+        outputs=...)``). The balancing moment needs the input's pair; without it, it is NaN.
+        Default: every pair and the balancing moment.
     """
     mech, structure = motion.mechanism, motion.structure
     if motion.second is None:
         raise InputError("reactions need a motion analysed with order=2")
     loads = loads_of(mech) if loads is None else loads
-    terms = evaluate_loads(motion, loads, ends)
+    group_ids = range(len(structure.groups)) if pairs is None else structure.loading_groups(set(pairs))
+    unknown = set() if pairs is None else set(pairs) - set(structure.joints)
+    if unknown:
+        raise InputError(f"mechanism '{mech.name}' has no pair(s) {sorted(unknown)} (pairs {sorted(structure.joints)})")
+    everything = len(group_ids) == len(structure.groups)
+    links = {k for i in group_ids for k in structure.groups[i].links} | (set(structure.inputs) if everything else set())
+    missing = sorted(links - set(motion.poses))
+    if missing:
+        raise InputError(f"the reactions asked for need links {missing}, which the motion does not place "
+                         "(analyze them: outputs=...)")
+    terms = evaluate_loads(motion, loads, ends, None if everything else links)
     if inertia and motion.omega is not None:
-        terms += inertia_terms(motion)
+        terms += inertia_terms(motion, None if everything else links)
     applied = generalized_loads(motion, terms)
     multipliers: dict[str, np.ndarray] = {}
-    for group in reversed(structure.groups):
+    for i in reversed(group_ids):
+        group = structure.groups[i]
         lam, transmitted = group.reactions(motion.poses, applied, valid=motion.status == OK)
         multipliers.update(lam)
         for link, load in transmitted.items():
             applied[link] = applied[link] + load
+    if not everything:
+        notes = loads.notes + ("balancing moment not computed: only the reactions in pairs "
+                               f"{sorted(pairs)} were asked for",)
+        return Reactions(motion, multipliers, np.full(len(motion.phi), np.nan), terms, notes)
     (link,) = structure.inputs
     joint = structure.input_joints[link]
     jac = joint.jacobian(motion.poses)[link]  # (N, 2, 3)

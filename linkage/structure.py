@@ -75,6 +75,22 @@ class Structure:
         return sorted(needed)
 
 
+    def loading_groups(self, pairs) -> list[int]:
+        """Indices (in order) of the groups whose kinetostatics the reactions in ``pairs`` need:
+        the groups of those pairs and every group that loads their links, directly or through
+        other groups (the groups farther from the input). A pair of an input link needs all."""
+        if any(j.name in pairs for j in self.input_joints.values()):
+            return list(range(len(self.groups)))
+        needed = {i for i, g in enumerate(self.groups) if any(j.name in pairs for j in g.joints)}
+        grew = True
+        while grew:
+            links = {k for i in needed for k in self.groups[i].links}
+            more = {i for i, g in enumerate(self.groups) if links & set(g.known_links)} - needed
+            needed |= more
+            grew = bool(more)
+        return sorted(needed)
+
+
 def mobility(mech: Mechanism) -> int:
     """Degrees of freedom by Chebyshev's formula ``W = 3 n - 2 p5 - p4`` (lower pairs only)."""
     return 3 * len(mech.moving_links) - 2 * len(mech.pairs)

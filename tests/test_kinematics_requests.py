@@ -2,6 +2,7 @@
 velocities and accelerations from per-position omega and eps."""
 
 import warnings
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -78,3 +79,79 @@ def test_real_velocity_and_acceleration_with_per_position_omega_and_eps():
     np.testing.assert_allclose(motion.acceleration("D")[:, 1], 0.0, atol=1e-15)
     with pytest.raises(ValueError, match="need omega"):
         linkage.analyze(mech, phi).velocity("D")
+
+
+# ----------------------------------------------------------------------------------------------
+# only what a request needs, counted: group evaluations, their orders, the force work
+# ----------------------------------------------------------------------------------------------
+
+
+class _Counter:
+    """Counts the solves and kinetostatic solutions of every group kind (wrapping the methods)."""
+
+    def __init__(self, monkeypatch):
+        from assur.base import Group
+        from assur.dyad import Dyad
+
+        self.solves, self.reactions = [], []
+        solve, reactions = Dyad.solve, Group.reactions
+
+        def counted_solve(group, poses, first=None, second=None, *args, **kwargs):
+            self.solves.append((repr(group), 0 if first is None else 1 if second is None else 2))
+            return solve(group, poses, first, second, *args, **kwargs)
+
+        def counted_reactions(group, *args, **kwargs):
+            self.reactions.append(repr(group))
+            return reactions(group, *args, **kwargs)
+
+        monkeypatch.setattr(Dyad, "solve", counted_solve)
+        monkeypatch.setattr(Group, "reactions", counted_reactions)
+
+
+def test_one_point_runs_only_its_ancestors_and_no_derivatives(monkeypatch):
+    mech = linkage.load("six_bar")        # I(0,1) -> II-RRR(2,3) -> II-RRP(4,5)
+    linkage.analyze(mech, [0.3])         # loads and caches the assembly plans outside the count
+    count = _Counter(monkeypatch)
+    phi = np.radians(np.arange(0.0, 360.0, 30.0))
+    motion = linkage.analyze(mech, phi, order=0, outputs=["B"])
+    assert count.solves == [("II-RRR(2,3)", 0)]
+    assert motion.first is None and set(motion.poses) == {"0", "1", "2", "3"}
+    count.solves.clear()
+    linkage.analyze(mech, phi, order=1, outputs=["F.x"])
+    assert count.solves == [("II-RRR(2,3)", 1), ("II-RRP(4,5)", 1)]
+    assert count.reactions == []           # kinematics does no force work
+
+
+def test_one_reaction_runs_the_groups_it_needs(monkeypatch):
+    from linkage.kinetostatics import solve_reactions
+
+    mech = linkage.load("six_bar")
+    phi = np.radians(np.arange(0.0, 360.0, 30.0))
+    full = solve_reactions(linkage.analyze(mech, phi, omega=10.0))
+    count = _Counter(monkeypatch)
+    # the farthest group's pair: its group alone (and, for its kinematics, its ancestors)
+    farthest = [j.name for j in linkage.structure_of(mech).groups[1].joints]
+    motion = linkage.analyze(mech, phi, omega=10.0, outputs=["4", "5"])
+    count.solves.clear()
+    only = solve_reactions(motion, pairs=[farthest[0]])
+    assert count.reactions == ["II-RRP(4,5)"] and count.solves == []
+    np.testing.assert_allclose(only.multipliers[farthest[0]], full.multipliers[farthest[0]], rtol=1e-12, atol=1e-9)
+    assert np.all(np.isnan(only.balancing_moment)) and "balancing moment not computed" in only.notes[-1]
+    # a pair of the first group: that group and the group that loads it
+    count.reactions.clear()
+    near = linkage.structure_of(mech).groups[0].joints[1].name
+    solve_reactions(linkage.analyze(mech, phi, omega=10.0), pairs=[near])
+    assert count.reactions == ["II-RRP(4,5)", "II-RRR(2,3)"]
+
+
+def test_massless_links_give_no_inertia_work():
+    from linkage.forces import inertia_terms
+
+    mech = linkage.load("four_bar")             # links 1, 2, 3 carry masses
+    motion = linkage.analyze(mech, [0.1, 0.2], omega=5.0)
+    assert [t.link for t in inertia_terms(motion)] == ["1", "2", "3"]
+    assert inertia_terms(motion, ["2"])[0].link == "2" and len(inertia_terms(motion, ["2"])) == 1
+    bare = linkage.loads((Path(__file__).resolve().parent.parent / "schemes" / "four_bar.toml").read_text()
+                         .replace("mass = 1.0", "").replace("mass = 3.0", "").replace("mass = 2.0", "")
+                         .replace("inertia = 0.0225", "").replace("inertia = 0.0104167", ""))
+    assert inertia_terms(linkage.analyze(bare, [0.1, 0.2], omega=5.0)) == []
