@@ -15,7 +15,7 @@ Results are exact: positions by each group's closed form, first and second trans
 from __future__ import annotations
 
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Iterable, Literal
 
 import numpy as np
@@ -93,6 +93,16 @@ class Motion:
     eps: np.ndarray | None = None
     conditioning: dict[str, np.ndarray] | None = None
     error_bound: np.ndarray | None = None
+    _turns: dict = field(default_factory=dict, init=False, repr=False, compare=False)
+
+    def _turn(self, link: str, local) -> tuple[np.ndarray, np.ndarray]:
+        """``Rot(theta) p`` ``(x, y)`` for a local point of ``link``, the link's cosines and sines
+        computed once per motion."""
+        if link not in self._turns:
+            theta = self.poses[link][:, 2]
+            self._turns[link] = (np.cos(theta), np.sin(theta))
+        c, s = self._turns[link]
+        return c * local[0] - s * local[1], s * local[0] + c * local[1]
 
     @property
     def joints(self) -> dict:
@@ -107,13 +117,28 @@ class Motion:
     def point(self, name: str) -> np.ndarray:
         """Global position ``(N, 2)`` of a named point, m."""
         link, local = self._point(name)
-        return global_point(self.poses[link], local)
+        rx, ry = self._turn(link, local)
+        pose = self.poses[link]
+        out = np.empty((len(rx), 2))
+        out[:, 0], out[:, 1] = pose[:, 0] + rx, pose[:, 1] + ry
+        return out
 
     def point_analogs(self, name: str) -> tuple[np.ndarray, np.ndarray | None]:
         """First and second analogs ``(N, 2)`` of a named point, m/rad and m/rad^2."""
         link, local = self._point(name)
         self._need(1)
-        return point_analogs(self.poses[link], self.first[link], self.second and self.second[link], local)
+        rx, ry = self._turn(link, local)
+        q1 = self.first[link]
+        w = q1[:, 2]
+        d1 = np.empty((len(rx), 2))
+        d1[:, 0], d1[:, 1] = q1[:, 0] - w * ry, q1[:, 1] + w * rx
+        if self.second is None:
+            return d1, None
+        q2 = self.second[link]
+        a, w2 = q2[:, 2], w * w
+        d2 = np.empty((len(rx), 2))
+        d2[:, 0], d2[:, 1] = q2[:, 0] - a * ry - w2 * rx, q2[:, 1] + a * rx - w2 * ry
+        return d1, d2
 
     def _point(self, name: str):
         link = self.mechanism.point_link(name)
