@@ -12,7 +12,7 @@
    fresh clone met (issue 8); the root ``conftest.py`` makes the two import the same source tree,
    so the prefix is accepted only while it is there.
 2. Every file the README and the documentation cite exists: backticked paths under a top-level
-   folder of the repository (``docs/methods.md``, ``benchmarks/results.md``, ``assur/rrr.py``),
+   folder of the repository (``docs/methods.md``, ``benchmarks/RESULTS.md``, ``assur/rrr.py``),
    the same in code blocks, and the targets (and ``#anchors``) of relative Markdown links.
 3. Nothing the project carries cites a document that is not in it (``METHOD``, ``DESIGN``,
    ``STYLE``): not the README, the docs, the scheme format, the ``--help`` texts, nor the
