@@ -2,12 +2,15 @@
 
 Varies the crank OA and the rocker CB of the shipped four-bar, analyses every variant with
 ``linkage.analyze_variants`` and prints, for the best variants, the rocker's swing and the
-smallest transmission angle. Run: ``python examples/variant_sweep.py``.
+smallest transmission angle, and draws the swing over the two dimensions into
+``OUT/variant_sweep.png`` (matplotlib, the ``plot`` extra). Run: ``python examples/variant_sweep.py [OUT]``.
 """
 
 from __future__ import annotations
 
+import sys
 import time
+from pathlib import Path
 
 import numpy as np
 
@@ -37,3 +40,22 @@ best = np.argsort(np.where(ok & (mu >= 40.0), -swing, np.inf))[:5]
 print(" OA (m)   CB (m)   swing (deg)   min transmission angle (deg)")
 for v in best:
     print(f"{crank[v]:.4f}   {rocker[v]:.4f}   {swing[v]:10.2f}   {mu[v]:10.2f}")
+
+import matplotlib.pyplot as plt  # noqa: E402  (the picture only)
+
+out = Path(sys.argv[1] if len(sys.argv) > 1 else ".")
+out.mkdir(parents=True, exist_ok=True)
+fig, ax = plt.subplots(figsize=(6.4, 4.6), layout="constrained")
+shape = (50, 40)
+filled = ax.contourf(crank.reshape(shape) * 1e3, rocker.reshape(shape) * 1e3, swing.reshape(shape), levels=12)
+lines = ax.contour(crank.reshape(shape) * 1e3, rocker.reshape(shape) * 1e3, mu.reshape(shape), levels=[40.0],
+                   colors="white", linestyles="--")
+ax.clabel(lines, fmt="μ_min = 40°")
+ax.plot(crank[best[0]] * 1e3, rocker[best[0]] * 1e3, "w*", markersize=12, label="largest swing with μ_min ≥ 40°")
+fig.colorbar(filled, ax=ax, label="swing of the rocker, deg")
+ax.set_xlabel("crank OA, mm")
+ax.set_ylabel("rocker CB, mm")
+ax.set_title(f"{batch.count} four-bars (AB = 300 mm, OC = 300 mm), one call")
+ax.legend(loc="upper left")
+fig.savefig(out / "variant_sweep.png", dpi=120)
+print(f"picture: {out / 'variant_sweep.png'}")
