@@ -444,7 +444,7 @@ run = getattr(trade, "run", None)
 if not callable(run):
     print("benchmarks/trade.py has no run(quick) function", file=sys.stderr)
     sys.exit(3)
-print(json.dumps([str(line) for line in run(sys.argv[2] == "quick")]))
+print(json.dumps([str(line) for line in run(sys.argv[2] == "quick", images=None)]))
 """
 
 
