@@ -50,6 +50,7 @@ __all__ = [
     "GroupSolution",
     "rotate",
     "perp",
+    "error_bound",
     "global_point",
     "point_analogs",
 ]
@@ -101,6 +102,14 @@ def dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 def angle_of(v: np.ndarray) -> np.ndarray:
     """Direction angle (rad) of vectors ``(..., 2)``."""
     return np.arctan2(v[..., 1], v[..., 0])
+
+
+def error_bound(ratio: np.ndarray, input_error) -> np.ndarray:
+    """Bound ``(N,)`` of the relative error of a group's first analogs for its conditioning
+    ``ratio``: ``ROUNDOFF_FACTOR * eps / r**2 + input_error / r`` (inf where r = 0)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        own = np.where(ratio > 0, ROUNDOFF_FACTOR * np.finfo(float).eps / ratio**2, np.inf)
+        return own + np.where(np.asarray(input_error) > 0, input_error / ratio, 0.0)
 
 
 def global_point(pose: np.ndarray, local) -> np.ndarray:
@@ -328,9 +337,7 @@ class Group(ABC):
             sign[assembled] = det_sign
             conditioning[assembled] = ratio
             incoming = np.broadcast_to(np.asarray(input_error, float), status.shape)[assembled]
-            with np.errstate(divide="ignore", invalid="ignore"):
-                own = np.where(ratio > 0, ROUNDOFF_FACTOR * np.finfo(float).eps / ratio**2, np.inf)
-                bound[assembled] = own + np.where(incoming > 0, incoming / ratio, 0.0)
+            bound[assembled] = error_bound(ratio, incoming)
             status[assembled & ~(bound <= ANALOG_TOL)] = SINGULAR
         for k in new:
             new[k] = np.where(assembled[:, None], new[k], np.nan)

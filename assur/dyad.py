@@ -12,8 +12,8 @@ from typing import ClassVar
 
 import numpy as np
 
-from .base import (ANALOG_TOL, CANNOT_ASSEMBLE, CLOSURE_TOL, OK, ROUNDOFF_FACTOR, SINGULAR, Group,
-                   GroupSolution, Joint, PrismaticJoint)
+from .base import (ANALOG_TOL, CANNOT_ASSEMBLE, CLOSURE_TOL, OK, SINGULAR, Group, GroupSolution, Joint,
+                   PrismaticJoint, error_bound)
 from .rows import arm, frame, rows_of, xy
 
 __all__ = ["Dyad"]
@@ -78,11 +78,12 @@ class Dyad(Group):
         with np.errstate(invalid="ignore"):
             assembled = ok & (closure <= CLOSURE_TOL * self.size)   # False where NaN
         l1, l2 = self.links
-        ratio, det = self._conditioning(rows, frames)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            own = ROUNDOFF_FACTOR * np.finfo(float).eps / (ratio * ratio)
-            bound = np.where(ratio > 0, own, np.inf) + np.where(np.asarray(input_error) > 0, input_error / ratio, 0.0)
-        bound = np.where(assembled, bound, np.inf)
+        # the null vectors of the external pairs, carried through the inner pair: the columns of
+        # the 2x2 system of both analog orders, whose determinant is the group Jacobian's
+        c1, c2 = inner.act(l1, ext1.null(l1)), inner.act(l2, ext2.null(l2))
+        det = c1[0] * c2[1] - c1[1] * c2[0]
+        ratio = self._conditioning(rows, frames, det)
+        bound = np.where(assembled, error_bound(ratio, input_error), np.inf)
         status = np.where(assembled, np.where(bound <= ANALOG_TOL, OK, SINGULAR), CANNOT_ASSEMBLE)
         sign = np.where(assembled, np.sign(det), 0.0)
         conditioning = np.where(assembled, ratio, np.nan)
@@ -95,44 +96,43 @@ class Dyad(Group):
         if first is not None:
             bad = status != OK
             with np.errstate(divide="ignore", invalid="ignore"):
-                det_safe = np.where(bad, 1.0, det)
+                system = (c1, c2, np.where(bad, 1.0, det))
                 known = {k: _columns(first[k]) for k in self.known_links}
-                q1, q2 = self._eliminate(rows, known, None, det_safe)
+                q1, q2 = self._eliminate(rows, system, known, None)
                 d1 = {l1: _pose_array(q1, bad, into[1], l1), l2: _pose_array(q2, bad, into[1], l2)}
                 if second is not None:
-                    all_first = {**known, l1: q1, l2: q2}
-                    gammas = [r.quadratic(all_first) for r in rows]
+                    gammas = [r.quadratic({**known, l1: q1, l2: q2}) for r in rows]
                     known2 = {k: _columns(second[k]) for k in self.known_links}
-                    a1, a2 = self._eliminate(rows, known2, gammas, det_safe)
+                    a1, a2 = self._eliminate(rows, system, known2, gammas)
                     d2 = {l1: _pose_array(a1, bad, into[2], l1), l2: _pose_array(a2, bad, into[2], l2)}
         return GroupSolution(new, status, sign, conditioning, bound, d1, d2)
 
-    def _eliminate(self, rows, known, gammas, det):
+    def _eliminate(self, rows, system, known, gammas):
         """Generalized velocities ``(tx, ty, w)`` of L1 and L2 from the rows' right-hand sides
-        ``gamma - Phi_k q_k`` (``gamma`` = 0 for first analogs)."""
+        ``gamma - Phi_k q_k`` (``gamma`` = 0 for first analogs); ``system`` = the 2x2 system's
+        columns and determinant (see :meth:`solve`)."""
         l1, l2 = self.links
         ext1, inner, ext2 = rows
+        c1, c2, det = system
 
-        def rhs(r, i, link):
+        def rhs(i, link):
+            r = rows[i]
             other = r.links[0] if r.links[1] == link else r.links[1]
             k0, k1 = r.act(other, known[other])
-            if gammas is None:
-                return -k0, -k1
-            return gammas[i][0] - k0, gammas[i][1] - k1
+            g = (0.0, 0.0) if gammas is None else gammas[i]
+            return g[0] - k0, g[1] - k1
 
-        p1, n1 = ext1.particular(l1, rhs(ext1, 0, l1))
-        p2, n2 = ext2.particular(l2, rhs(ext2, 2, l2))
-        c1, c2 = inner.act(l1, n1), inner.act(l2, n2)
+        p1, p2 = ext1.particular(l1, rhs(0, l1)), ext2.particular(l2, rhs(2, l2))
         a1, a2 = inner.act(l1, p1), inner.act(l2, p2)
         g = (0.0, 0.0) if gammas is None else gammas[1]
         rx, ry = g[0] - a1[0] - a2[0], g[1] - a1[1] - a2[1]
         tau1 = (rx * c2[1] - ry * c2[0]) / det
         tau2 = (c1[0] * ry - c1[1] * rx) / det
-        return ([p + tau1 * n for p, n in zip(p1, n1)], [p + tau2 * n for p, n in zip(p2, n2)])
+        return ([p + tau1 * n for p, n in zip(p1, ext1.null(l1))], [p + tau2 * n for p, n in zip(p2, ext2.null(l2))])
 
-    def _conditioning(self, rows, frames):
+    def _conditioning(self, rows, frames, det):
         """:meth:`Group.conditioning` elementwise: the Hadamard ratio ``(N,)`` of the scaled
-        Jacobian and the determinant ``(N,)`` of the unscaled one."""
+        Jacobian, from the determinant ``det`` ``(N,)`` of the unscaled one."""
         l1, l2 = self.links
         ext1, inner, ext2 = rows
         (ax, ay), (bx, by), (cx, cy) = ext1.contact, inner.contact, ext2.contact
@@ -151,19 +151,13 @@ class Dyad(Group):
                     s0, s1 = r.norms_squared(link, centroid[link], frames[link], scale)
                     row0, row1 = row0 + s0, row1 + s1
             product = product * row0 * row1
-        _, n1 = ext1.particular(l1, (0.0, 0.0))
-        _, n2 = ext2.particular(l2, (0.0, 0.0))
-        c1, c2 = inner.act(l1, n1), inner.act(l2, n2)
-        det = c1[0] * c2[1] - c1[1] * c2[0]
         prismatic = sum(r.kind == "P" for r in rows)
         with np.errstate(invalid="ignore"):
-            ratio = np.abs(det) * scale ** (prismatic - 2) / np.sqrt(product)
-        return ratio, det
+            return np.abs(det) * scale ** (prismatic - 2) / np.sqrt(product)
 
     # -- positions -----------------------------------------------------------------------------
     def _position(self, poses, branch):
-        frames = {k: frame(poses[k]) for k in self.known_links}
-        placed, ok = self._place(frames, branch)
+        placed, ok = self._place(self._frames(poses), branch)
         return {k: np.column_stack([f[0], f[1], f[4]]) for k, f in placed.items()}, ok
 
     @abstractmethod
@@ -172,6 +166,7 @@ class Dyad(Group):
         links' frames ``(x, y, c, s, theta)`` (:func:`assur.rows.frame`)."""
 
     def _frames(self, poses):
+        """Frames of the known links from their poses."""
         return {k: frame(poses[k]) for k in self.known_links}
 
     # -- helpers for closed forms (vectors as (x, y) pairs of (N,) arrays) ------------------------
@@ -191,10 +186,10 @@ class Dyad(Group):
         return (f[0] + gx, f[1] + gy), arm(f, xy(joint.u))
 
     @staticmethod
-    def turned(f, beta):
-        """``(c, s, theta)`` of the angle ``theta + beta`` for a frame ``f``."""
+    def turned(c, s, theta, beta):
+        """``(c, s, theta)`` of the angle ``theta + beta`` from the cosine and sine of ``theta``."""
         cb, sb = np.cos(beta), np.sin(beta)
-        return f[2] * cb - f[3] * sb, f[3] * cb + f[2] * sb, f[4] + beta
+        return c * cb - s * sb, s * cb + c * sb, theta + beta
 
     @staticmethod
     def place_by_two_points(p1, p2, local_1, local_2, length):

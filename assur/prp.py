@@ -24,7 +24,7 @@ class PRP(Dyad):
         lines, angles = [], []
         for guide, link in ((self.ext1, l1), (self.ext2, l2)):
             G, u = self.guide_line(frames, guide)
-            c, s, theta = self.turned(frames[guide.a], guide.beta)
+            c, s, theta = self.turned(*frames[guide.a][2:], guide.beta)
             (bx, by), (px, py) = xy(self.inner.local(link)[0]), xy(guide.p)
             lines.append(((G[0] + c * (bx - px) - s * (by - py), G[1] + s * (bx - px) + c * (by - py)), u))
             angles.append((c, s, theta))

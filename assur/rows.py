@@ -71,10 +71,14 @@ class RevoluteRows:
         return s * (tx - w * ry), s * (ty + w * rx)
 
     def particular(self, link, r):
-        """A velocity of ``link`` that the rows map to ``r``, and the rows' null vector."""
-        rx, ry = self.arms[link]
+        """A velocity of ``link`` that the rows map to ``r``."""
         s = self.sign[link]
-        return (s * r[0], s * r[1], 0.0), (ry, -rx, 1.0)
+        return s * r[0], s * r[1], 0.0
+
+    def null(self, link):
+        """The null vector of the rows in ``link``'s columns: their cross product."""
+        rx, ry = self.arms[link]
+        return ry, -rx, 1.0
 
     def quadratic(self, first):
         """``gamma`` of the second-analog rows: ``w_a^2 rho_a - w_b^2 rho_b``."""
@@ -110,7 +114,6 @@ class PrismaticRows:
         #: rotation entries of row 0: link a (guide) and link b (slider)
         self.w0 = {joint.a: -(ud + self.ga[0] * ny - self.ga[1] * nx), joint.b: self.pb[0] * ny - self.pb[1] * nx}
         self.sign = {joint.a: -1.0, joint.b: 1.0}
-        self.ud = ud
 
     def residual(self, frames, size):
         """Largest absolute residual ``(N,)``: the normal offset, m, and the angle times ``size``."""
@@ -128,7 +131,10 @@ class PrismaticRows:
         s = self.sign[link]
         w = s * r[1]
         along = s * (r[0] - self.w0[link] * w)
-        return (along * self.n[0], along * self.n[1], w), (self.u[0], self.u[1], 0.0)
+        return along * self.n[0], along * self.n[1], w
+
+    def null(self, link):
+        return self.u[0], self.u[1], 0.0
 
     def quadratic(self, first):
         """``gamma``: ``(n.d) w_a^2 + 2 w_a (u.d') + n.(p_b w_b^2 - g_a w_a^2)`` and 0."""

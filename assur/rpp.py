@@ -25,8 +25,8 @@ class RPP(Dyad):
         slot, guide = self.inner, self.ext2
         A = self.known_point(frames, self.ext1, l1)
         G, u = self.guide_line(frames, guide)
-        c2, s2, theta2 = self.turned(frames[guide.a], guide.beta)
-        c1, s1, theta1 = self.turned((None, None, c2, s2, theta2), slot.beta)
+        c2, s2, theta2 = self.turned(*frames[guide.a][2:], guide.beta)
+        c1, s1, theta1 = self.turned(c2, s2, theta2, slot.beta)
         (ax, ay), (px, py) = xy(self.ext1.local(l1)[0]), xy(slot.p)
         S1 = A[0] + c1 * (px - ax) - s1 * (py - ay), A[1] + s1 * (px - ax) + c1 * (py - ay)
         (sux, suy), (gx, gy), (qx, qy) = xy(slot.u), xy(slot.g), xy(guide.p)

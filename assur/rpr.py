@@ -48,7 +48,7 @@ class RPR(Dyad):
             theta2 = theta2 + 2 * np.arcsin(ratio) - np.pi
         theta2 = (theta2 + np.pi) % (2 * np.pi) - np.pi
         c2, s2 = np.cos(theta2), np.sin(theta2)
-        c1, s1, theta1 = self.turned((None, None, c2, s2, theta2), slot.beta)
+        c1, s1, theta1 = self.turned(c2, s2, theta2, slot.beta)
         return {
             l1: self.place_by_point_and_angle(A, self.ext1.local(l1)[0], c1, s1, theta1),
             l2: self.place_by_point_and_angle(C, self.ext2.local(l2)[0], c2, s2, theta2),

@@ -28,7 +28,7 @@ class RRP(Dyad):
         guide = self.ext2
         A = self.known_point(frames, self.ext1, l1)
         G, u = self.guide_line(frames, guide)
-        c2, s2, theta2 = self.turned(frames[guide.a], guide.beta)
+        c2, s2, theta2 = self.turned(*frames[guide.a][2:], guide.beta)
         (bx, by), (px, py) = xy(self.inner.local(l2)[0]), xy(guide.p)
         G_B = G[0] + c2 * (bx - px) - s2 * (by - py), G[1] + s2 * (bx - px) + c2 * (by - py)
         (ax, ay), (b1x, b1y) = xy(self.ext1.local(l1)[0]), xy(self.inner.local(l1)[0])
