@@ -117,9 +117,10 @@ def global_point(pose: np.ndarray, local) -> np.ndarray:
     return pose[:, :2] + rotate(pose[:, 2], local)
 
 
-def point_analogs(pose, first, second, local):
-    """First and second analogs ``(N, 2)`` of a point fixed in a link (docs/methods.md#analogs)."""
-    rho = rotate(pose[:, 2], local)
+def point_analogs(pose, first, second, local, rho=None):
+    """First and second analogs ``(N, 2)`` of a point fixed in a link (docs/methods.md#analogs);
+    ``rho`` = ``Rot(theta) local`` ``(N, 2)`` when the caller has it."""
+    rho = rotate(pose[:, 2], local) if rho is None else rho
     d1 = None if first is None else first[:, :2] + perp(rho) * first[:, 2:3]
     d2 = None
     if second is not None:

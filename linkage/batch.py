@@ -27,7 +27,7 @@ from assur.base import OK, RevoluteJoint, global_point, point_analogs
 
 from .assembly import assembly_plans
 from .errors import AssemblyError, InputError
-from .kinematics import BLOCK, BranchWarning, _jumps, _run_blocks, structure_of
+from .kinematics import JUMP_CHECK_STEP, BranchWarning, _run_blocks, jump_steps, structure_of
 from .model import Mechanism
 
 __all__ = ["OTHER_BRANCH", "VariantMotion", "analyze_variants", "geometry_of"]
@@ -327,26 +327,16 @@ def _moves_too_far(group, poses, first, solved: np.ndarray, phi: np.ndarray, sca
     """``(V,)``: between two analysed angles at most 10 deg apart a link moves more than its
     analogs allow (the jump check of :func:`linkage.analyze`, variant by variant; ``scale``,
     m, weighs the links' turns)."""
-    from .kinematics import JUMP_CHECK_STEP
-
     count, n = solved.shape
     if n < 2:
         return np.zeros(count, bool)
     dphi = np.diff(phi)
-    steps = (np.abs(dphi) <= JUMP_CHECK_STEP) & (dphi != 0)
-    pairs = (solved[:, :-1] == OK) & (solved[:, 1:] == OK) & steps
-    bad = np.zeros(count, bool)
-    if not pairs.any():
-        return bad
-    rows = max(1, BLOCK // n)
-    for start in range(0, count, rows):
-        variants = slice(start, min(start + rows, count))
-        flat = slice(variants.start * n, variants.stop * n)
-        moved = _jumps({k: poses[k][flat] for k in group.links}, {k: first[k][flat] for k in group.links},
-                       np.tile(np.append(dphi, 0.0), variants.stop - variants.start)[:-1], scale)
-        moved = np.append(moved, False).reshape(-1, n)[:, :-1]
-        bad[variants] = np.any(moved & pairs[variants], axis=1)
-    return bad
+    pairs = (solved[:, :-1] == OK) & (solved[:, 1:] == OK) & (np.abs(dphi) <= JUMP_CHECK_STEP) & (dphi != 0)
+    # flattened over variants: the step from one variant's last angle to the next variant is no step
+    flat_pairs = np.column_stack([pairs, np.zeros(count, bool)]).ravel()[:-1]
+    flat_dphi = np.tile(np.append(dphi, 0.0), count)[:-1]
+    bad = jump_steps(group, poses, first, flat_pairs, flat_dphi, scale)
+    return np.append(bad, False).reshape(count, n)[:, :-1].any(axis=1)
 
 
 def _other_branch(mech: Mechanism, group, poses: dict, local: dict, count: int, n: int) -> np.ndarray:

@@ -95,14 +95,14 @@ class Motion:
     error_bound: np.ndarray | None = None
     _turns: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
-    def _turn(self, link: str, local) -> tuple[np.ndarray, np.ndarray]:
-        """``Rot(theta) p`` ``(x, y)`` for a local point of ``link``, the link's cosines and sines
+    def _arm(self, link: str, local) -> np.ndarray:
+        """``Rot(theta) p`` ``(N, 2)`` for a local point of ``link``, the link's cosines and sines
         computed once per motion."""
         if link not in self._turns:
             theta = self.poses[link][:, 2]
             self._turns[link] = (np.cos(theta), np.sin(theta))
         c, s = self._turns[link]
-        return c * local[0] - s * local[1], s * local[0] + c * local[1]
+        return np.column_stack([c * local[0] - s * local[1], s * local[0] + c * local[1]])
 
     @property
     def joints(self) -> dict:
@@ -117,28 +117,14 @@ class Motion:
     def point(self, name: str) -> np.ndarray:
         """Global position ``(N, 2)`` of a named point, m."""
         link, local = self._point(name)
-        rx, ry = self._turn(link, local)
-        pose = self.poses[link]
-        out = np.empty((len(rx), 2))
-        out[:, 0], out[:, 1] = pose[:, 0] + rx, pose[:, 1] + ry
-        return out
+        return self.poses[link][:, :2] + self._arm(link, local)
 
     def point_analogs(self, name: str) -> tuple[np.ndarray, np.ndarray | None]:
         """First and second analogs ``(N, 2)`` of a named point, m/rad and m/rad^2."""
         link, local = self._point(name)
         self._need(1)
-        rx, ry = self._turn(link, local)
-        q1 = self.first[link]
-        w = q1[:, 2]
-        d1 = np.empty((len(rx), 2))
-        d1[:, 0], d1[:, 1] = q1[:, 0] - w * ry, q1[:, 1] + w * rx
-        if self.second is None:
-            return d1, None
-        q2 = self.second[link]
-        a, w2 = q2[:, 2], w * w
-        d2 = np.empty((len(rx), 2))
-        d2[:, 0], d2[:, 1] = q2[:, 0] - a * ry - w2 * rx, q2[:, 1] + a * rx - w2 * ry
-        return d1, d2
+        return point_analogs(self.poses[link], self.first[link], self.second and self.second[link], local,
+                             self._arm(link, local))
 
     def _point(self, name: str):
         link = self.mechanism.point_link(name)
@@ -592,13 +578,7 @@ def _check_jumps(group, plan, poses, first, status, phi) -> None:
     sample = np.flatnonzero(status == OK)
     sample = sample[:: max(1, len(sample) // 4096)]
     scale = float(np.median(group.scale({k: v[sample] for k, v in poses.items()})))
-    bad = np.zeros(len(dphi), bool)
-    for start in range(0, len(dphi), BLOCK):
-        steps = slice(start, min(start + BLOCK, len(dphi)))
-        if pairs[steps].any():
-            ends = slice(steps.start, steps.stop + 1)
-            bad[steps] = _jumps({k: poses[k][ends] for k in group.links}, {k: first[k][ends] for k in group.links},
-                                dphi[steps], scale) & pairs[steps]
+    bad = jump_steps(group, poses, first, pairs, dphi, scale)
     if bad.any():
         k = np.flatnonzero(bad)
         shown = ", ".join(f"{np.degrees(phi[j]):.6g}..{np.degrees(phi[j + 1]):.6g}" for j in k[:5])
@@ -606,6 +586,20 @@ def _check_jumps(group, plan, poses, first, status, phi) -> None:
             f"group {group!r} moves between the input angles {shown} deg more than its analogs "
             "allow: it passes a change point or a singular position between them (analyse finer "
             "angles there)", BranchWarning, stacklevel=3)
+
+
+def jump_steps(group, poses: dict, first: dict, pairs: np.ndarray, dphi: np.ndarray, scale: float) -> np.ndarray:
+    """``(N-1,)``: the steps among ``pairs`` (bool ``(N-1,)``) between consecutive positions (angle
+    steps ``dphi``) where a link of ``group`` moves more than its analogs allow (see
+    :func:`_check_jumps`; ``scale``, m, weighs the links' turns). :data:`BLOCK` steps at a time."""
+    bad = np.zeros(len(dphi), bool)
+    for start in range(0, len(dphi), BLOCK):
+        steps = slice(start, min(start + BLOCK, len(dphi)))
+        if pairs[steps].any():
+            ends = slice(steps.start, steps.stop + 1)
+            bad[steps] = _jumps({k: poses[k][ends] for k in group.links}, {k: first[k][ends] for k in group.links},
+                                dphi[steps], scale) & pairs[steps]
+    return bad
 
 
 def _jumps(poses: dict, first: dict, dphi: np.ndarray, scale: float) -> np.ndarray:
