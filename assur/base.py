@@ -62,6 +62,8 @@ CLOSURE_TOL = 1e-9
 #: the status-OK guarantee: first analogs accurate to this, relative to the largest first analog
 #: of the group and of the links it attaches to (second analogs: 10 times this)
 ANALOG_TOL = 1e-8
+#: contact points of a group closer than this fraction of the mechanism's size coincide
+COINCIDENT = 1e-9
 #: round-off model of a group's first analogs: relative error <= ROUNDOFF_FACTOR * eps / r**2
 #: for conditioning r (measured factor <= 0.26 for every dyad kind in benchmarks/results_guarantee.md;
 #: ten times that for a margin)
@@ -388,11 +390,13 @@ class Group(ABC):
 
     def scale(self, poses: Poses, contacts: np.ndarray | None = None) -> np.ndarray:
         """The group's own length scale ``(N,)``, m: the largest distance between the points where
-        its pairs act (at least the round-off of their coordinates; 1 where they all coincide)."""
+        its pairs act; at least the round-off of their coordinates and :data:`COINCIDENT` times the
+        mechanism's size (points closer than that coincide: a Scotch yoke's pin and slider points),
+        so that round-off in coinciding points does not enter the conditioning."""
         contacts = self.contact_points(poses) if contacts is None else contacts
         spread = np.linalg.norm(contacts[:, :, None, :] - contacts[:, None, :, :], axis=-1)
-        scale = np.maximum(np.max(spread, axis=(1, 2)), 1e-12 * np.max(np.abs(contacts), axis=(1, 2)))
-        return np.where(scale > 0, scale, 1.0)
+        floor = np.maximum(1e-12 * np.max(np.abs(contacts), axis=(1, 2)), COINCIDENT * self.size)
+        return np.maximum(np.max(spread, axis=(1, 2)), floor)
 
     def conditioning(self, phi_q: np.ndarray, poses: Poses) -> tuple[np.ndarray, np.ndarray]:
         """Scale-free conditioning of the group Jacobian and the sign of its determinant.

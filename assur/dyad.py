@@ -12,7 +12,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from .base import (ANALOG_TOL, CANNOT_ASSEMBLE, CLOSURE_TOL, OK, SINGULAR, Group, GroupSolution, Joint,
+from .base import (ANALOG_TOL, CANNOT_ASSEMBLE, CLOSURE_TOL, COINCIDENT, OK, SINGULAR, Group, GroupSolution, Joint,
                    PrismaticJoint, error_bound)
 from .rows import arm, frame, rows_of, xy
 
@@ -140,8 +140,7 @@ class Dyad(Group):
                             np.hypot(cx - ax, cy - ay))
         biggest = np.maximum(np.maximum(np.maximum(np.abs(ax), np.abs(ay)), np.maximum(np.abs(bx), np.abs(by))),
                              np.maximum(np.abs(cx), np.abs(cy)))
-        scale = np.maximum(spread, 1e-12 * biggest)
-        scale = np.where(scale > 0, scale, 1.0)
+        scale = np.maximum(spread, np.maximum(1e-12 * biggest, COINCIDENT * self.size))
         centroid = {l1: (0.5 * (ax + bx), 0.5 * (ay + by)), l2: (0.5 * (bx + cx), 0.5 * (by + cy))}
         product = 1.0
         for r in rows:

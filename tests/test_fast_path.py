@@ -29,8 +29,8 @@ PHI = np.linspace(-3.0, 3.0, 61)
 def assert_same(fast, oracle, size):
     """Statuses and signs equal; poses and analogs equal to round-off; conditioning and bounds to
     1e-6 relative (where a group's contact points coincide -- a PRP whose sliders' points are its
-    pin -- its scale is the floor 1e-12 |P| and the conditioning carries the contacts' round-off
-    amplified by 1e12 inside a sum with 1, about 1e-8 relative)."""
+    pin -- its scale is the floor 1e-9 of the mechanism's size, and the conditioning carries the
+    contacts' round-off amplified by 1e9 inside a sum with 1)."""
     np.testing.assert_array_equal(fast.status, oracle.status)
     ok = oracle.status == OK
     placed = oracle.status != CANNOT_ASSEMBLE
