@@ -496,7 +496,7 @@ class Group(ABC):
         return {link: q[:, 3 * i : 3 * i + 3] for i, link in enumerate(self.links)}
 
     # -- reactions -----------------------------------------------------------------------------
-    def reactions(self, poses: Poses, loads: Poses, valid=None):
+    def reactions(self, poses: Poses, loads: Poses, valid=None, frames=None):
         """Joint reactions from the equilibrium of the group's links.
 
         Parameters
@@ -508,6 +508,9 @@ class Group(ABC):
             and the moment about the link's local origin (N m), inertia loads included.
         valid : array_like of bool, optional
             Positions to solve (others give NaN), e.g. where the motion is assembled and regular.
+        frames : dict, optional
+            Link frames ``(x, y, cos, sin, theta)`` the caller has computed (used by closed-form
+            kinds; the generic path builds its Jacobian from ``poses``).
 
         Returns
         -------

@@ -154,6 +154,47 @@ class Dyad(Group):
         with np.errstate(invalid="ignore"):
             return np.abs(det) * scale ** (prismatic - 2) / np.sqrt(product)
 
+    # -- reactions: the transposed elimination --------------------------------------------------
+    def reactions(self, poses, loads, valid=None, frames=None):
+        """:meth:`Group.reactions` in closed form: the same multipliers and transmitted loads.
+
+        The transposed system ``Phi_q^T lambda = -Q`` is eliminated like the analogs: the load
+        on each link projected on its external pair's null vector involves only the inner pair's
+        multipliers (the 2x2 system of :meth:`solve`, transposed); the external pairs' multipliers
+        then carry what is left of their link's load. ``frames``: the links' frames
+        (:func:`assur.rows.frame`) when the caller has them.
+        """
+        l1, l2 = self.links
+        frames = {k: frame(poses[k]) for k in (l1, l2, *self.known_links)} if frames is None else frames
+        ext1, inner, ext2 = [rows_of(j, frames) for j in self.joints]
+        n1, n2 = ext1.null(l1), ext2.null(l2)
+        c1, c2 = inner.act(l1, n1), inner.act(l2, n2)
+        det = c1[0] * c2[1] - c1[1] * c2[0]
+        with np.errstate(invalid="ignore"):
+            ok = np.isfinite(det) & (det != 0)
+        if valid is not None:
+            ok &= np.asarray(valid, bool)
+        det = np.where(ok, det, 1.0)
+        q1, q2 = _columns(loads[l1]), _columns(loads[l2])
+        with np.errstate(invalid="ignore", over="ignore"):
+            b1 = -(n1[0] * q1[0] + n1[1] * q1[1] + n1[2] * q1[2])
+            b2 = -(n2[0] * q2[0] + n2[1] * q2[1] + n2[2] * q2[2])
+            lam_inner = ((b1 * c2[1] - b2 * c1[1]) / det, (c1[0] * b2 - c2[0] * b1) / det)
+            lam = {}
+            for r, link, q in ((ext1, l1, q1), (ext2, l2, q2)):
+                carried = inner.constraint_load(link, lam_inner)
+                lam[r] = r.multipliers(link, tuple(-a - b for a, b in zip(q, carried)))
+            lam[inner] = lam_inner
+            transmitted = {}
+            for r in (ext1, ext2):
+                known = r.links[0] if r.links[1] in self.links else r.links[1]
+                load = r.constraint_load(known, lam[r])
+                old = transmitted.get(known)
+                transmitted[known] = load if old is None else tuple(a + b for a, b in zip(old, load))
+        multipliers = {r.joint.name: _pose_array(lam[r], ~ok) for r in (ext1, inner, ext2)}
+        transmitted = {k: _pose_array(v, ~ok) for k, v in transmitted.items()}
+        return multipliers, transmitted
+
     # -- positions -----------------------------------------------------------------------------
     def _position(self, poses, branch):
         placed, ok = self._place(self._frames(poses), branch)
@@ -216,8 +257,8 @@ def _columns(q: np.ndarray):
 
 
 def _pose_array(q, bad: np.ndarray, into: dict | None = None, link: str | None = None) -> np.ndarray:
-    """Three columns as an ``(N, 3)`` array (``into[link]`` when given), NaN at the positions ``bad``."""
-    out = np.empty((len(bad), 3)) if into is None else into[link]
+    """Columns as an ``(N, len(q))`` array (``into[link]`` when given), NaN at the positions ``bad``."""
+    out = np.empty((len(bad), len(q))) if into is None else into[link]
     for i, column in enumerate(q):
         out[:, i] = column
     if bad.any():

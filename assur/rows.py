@@ -8,6 +8,9 @@ positions, exactly the quantities of :mod:`assur.base` -- residual, Jacobian row
 terms -- as separate ``x`` / ``y`` arrays, so that :meth:`assur.dyad.Dyad.solve` can eliminate
 the dyad's six unknowns in closed form.
 
+The transposed rows serve the kinetostatics the same way (:meth:`assur.dyad.Dyad.reactions`):
+``constraint_load`` is the load a pair's multipliers put on a link, ``multipliers`` its inverse.
+
 Conventions: a *frame* of a link is ``(x, y, c, s, theta)``, the origin, the cosine and sine of
 its angle and the angle, each ``(N,)``; its analogs are ``(vx, vy, w)`` (first) and ``(ax, ay, al)`` (second).
 Local coordinates are ``(2,)`` or ``(N, 2)`` (one geometry per position, for batches of design
@@ -80,6 +83,19 @@ class RevoluteRows:
         rx, ry = self.arms[link]
         return ry, -rx, 1.0
 
+    def constraint_load(self, link, lam):
+        """The rows' transpose applied to the multipliers ``lam = (l0, l1)``: the generalized load
+        ``(Fx, Fy, M)`` (moment about the link's origin) the pair puts on ``link``."""
+        rx, ry = self.arms[link]
+        s = self.sign[link]
+        return s * lam[0], s * lam[1], s * (rx * lam[1] - ry * lam[0])
+
+    def multipliers(self, link, load):
+        """The multipliers whose :meth:`constraint_load` on ``link`` is ``load`` (a load the rows
+        can carry: its moment is the force's moment about the pin)."""
+        s = self.sign[link]
+        return s * load[0], s * load[1]
+
     def quadratic(self, first):
         """``gamma`` of the second-analog rows: ``w_a^2 rho_a - w_b^2 rho_b``."""
         (ax, ay), (bx, by) = self.arms[self.joint.a], self.arms[self.joint.b]
@@ -135,6 +151,15 @@ class PrismaticRows:
 
     def null(self, link):
         return self.u[0], self.u[1], 0.0
+
+    def constraint_load(self, link, lam):
+        s = self.sign[link]
+        return s * self.n[0] * lam[0], s * self.n[1] * lam[0], self.w0[link] * lam[0] + s * lam[1]
+
+    def multipliers(self, link, load):
+        s = self.sign[link]
+        normal = s * (self.n[0] * load[0] + self.n[1] * load[1])
+        return normal, s * (load[2] - self.w0[link] * normal)
 
     def quadratic(self, first):
         """``gamma``: ``(n.d) w_a^2 + 2 w_a (u.d') + n.(p_b w_b^2 - g_a w_a^2)`` and 0."""

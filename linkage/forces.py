@@ -777,7 +777,8 @@ def inertia_terms(motion: Motion, links: Iterable[str] | None = None) -> list[Lo
         link = mech.links[k]
         if k not in wanted or link.mass == 0 and link.inertia == 0:
             continue
-        d1, d2 = point_analogs(motion.poses[k], motion.first[k], motion.second[k], link.center_of_mass)
+        d1, d2 = point_analogs(motion.poses[k], motion.first[k], motion.second[k], link.center_of_mass,
+                               motion.arm(k, link.center_of_mass))
         acc = d2 * (w**2)[:, None] + d1 * e[:, None]
         eps_k = motion.second[k][:, 2] * w**2 + motion.first[k][:, 2] * e
         terms.append(LoadTerm(k, link.center_of_mass, -link.mass * acc, -link.inertia * eps_k,
@@ -787,13 +788,12 @@ def inertia_terms(motion: Motion, links: Iterable[str] | None = None) -> list[Lo
 
 def generalized_loads(motion: Motion, terms: Sequence[LoadTerm]) -> dict[str, np.ndarray]:
     """Sum of terms per link as ``(Fx, Fy, moment about the link's local origin)`` ``(N, 3)``."""
-    from assur.base import cross, rotate
+    from assur.base import cross
 
     n = len(motion.phi)
     out = {k: np.zeros((n, 3)) for k in motion.mechanism.links}
     for t in terms:
-        arm = rotate(motion.poses[t.link][:, 2], t.local)
         out[t.link][:, :2] += t.force
-        out[t.link][:, 2] += cross(arm, t.force) + t.moment
+        out[t.link][:, 2] += cross(motion.arm(t.link, t.local), t.force) + t.moment
     return out
 

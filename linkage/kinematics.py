@@ -22,7 +22,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from assur.base import ANALOG_TOL, CANNOT_ASSEMBLE, OK, SINGULAR, global_point, point_analogs
-from assur.rows import xy
+from assur.rows import frame, xy
 
 from .assembly import assembly_branches, assembly_plans, place_group
 from .errors import AssemblyError, InputError, StructureError
@@ -95,14 +95,18 @@ class Motion:
     error_bound: np.ndarray | None = None
     _turns: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
-    def _arm(self, link: str, local) -> np.ndarray:
-        """``Rot(theta) p`` ``(N, 2)`` for a local point of ``link``, the link's cosines and sines
-        computed once per motion."""
-        if link not in self._turns:
-            theta = self.poses[link][:, 2]
-            self._turns[link] = (np.cos(theta), np.sin(theta))
-        c, s = self._turns[link]
+    def arm(self, link: str, local) -> np.ndarray:
+        """``Rot(theta) p`` ``(N, 2)``, m: the vector from ``link``'s origin to its local point
+        ``p`` ``(2,)`` in global axes, the link's cosines and sines computed once per motion."""
+        _, _, c, s, _ = self.frame(link)
         return np.column_stack([c * local[0] - s * local[1], s * local[0] + c * local[1]])
+
+    def frame(self, link: str) -> tuple[np.ndarray, ...]:
+        """``(x, y, cos theta, sin theta, theta)`` of ``link``, each ``(N,)`` (the solvers' link
+        frame, :func:`assur.rows.frame`), computed once per motion."""
+        if link not in self._turns:
+            self._turns[link] = frame(self.poses[link])
+        return self._turns[link]
 
     @property
     def joints(self) -> dict:
@@ -117,14 +121,14 @@ class Motion:
     def point(self, name: str) -> np.ndarray:
         """Global position ``(N, 2)`` of a named point, m."""
         link, local = self._point(name)
-        return self.poses[link][:, :2] + self._arm(link, local)
+        return self.poses[link][:, :2] + self.arm(link, local)
 
     def point_analogs(self, name: str) -> tuple[np.ndarray, np.ndarray | None]:
         """First and second analogs ``(N, 2)`` of a named point, m/rad and m/rad^2."""
         link, local = self._point(name)
         self._need(1)
         return point_analogs(self.poses[link], self.first[link], self.second and self.second[link], local,
-                             self._arm(link, local))
+                             self.arm(link, local))
 
     def _point(self, name: str):
         link = self.mechanism.point_link(name)

@@ -29,6 +29,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from assur.base import OK, PrismaticJoint, point_analogs
+from assur.rows import rows_of
 
 from .errors import InputError
 from .forces import LoadTerm, Loads, evaluate_loads, generalized_loads, inertia_terms, loads_of
@@ -163,9 +164,11 @@ def solve_reactions(
         terms += inertia_terms(motion, None if everything else links)
     applied = generalized_loads(motion, terms)
     multipliers: dict[str, np.ndarray] = {}
+    valid = motion.status == OK
     for i in reversed(group_ids):
         group = structure.groups[i]
-        lam, transmitted = group.reactions(motion.poses, applied, valid=motion.status == OK)
+        frames = {k: motion.frame(k) for k in (*group.links, *group.known_links)}
+        lam, transmitted = group.reactions(motion.poses, applied, valid=valid, frames=frames)
         multipliers.update(lam)
         for link, load in transmitted.items():
             applied[link] = applied[link] + load
@@ -175,14 +178,13 @@ def solve_reactions(
         return Reactions(motion, multipliers, np.full(len(motion.phi), np.nan), terms, notes)
     (link,) = structure.inputs
     joint = structure.input_joints[link]
-    jac = joint.jacobian(motion.poses)[link]  # (N, 2, 3)
-    system = np.concatenate([np.transpose(jac, (0, 2, 1)), np.tile([0.0, 0.0, 1.0], (len(jac), 1))[..., None]],
-                            axis=2)
-    bad = motion.status != OK
-    system[bad] = np.eye(3)
-    solution = np.linalg.solve(system, -applied[link][..., None])[..., 0]
-    multipliers[joint.name] = solution[:, :2]
-    balancing = solution[:, 2]
+    # the input link's equilibrium: its pin carries the force, M_b what is left of the moment
+    pin = rows_of(joint, {k: motion.frame(k) for k in (joint.a, joint.b)})
+    load = -applied[link]
+    force = pin.multipliers(link, (load[:, 0], load[:, 1], load[:, 2]))
+    multipliers[joint.name] = np.column_stack(force)
+    balancing = load[:, 2] - pin.constraint_load(link, force)[2]
+    bad = ~valid
     if bad.any():
         balancing = np.where(bad, np.nan, balancing)
         multipliers = {k: np.where(bad[:, None], np.nan, v) for k, v in multipliers.items()}

@@ -141,3 +141,39 @@ def test_batch_geometry_per_position_equals_one_geometry_at_a_time():
                 for got, want in ((together.poses, one.poses), (together.first, one.first),
                                   (together.second, one.second)):
                     np.testing.assert_allclose(got[link][i], want[link][0], rtol=1e-12, atol=1e-12)
+
+
+@pytest.mark.parametrize("kind", KINDS)
+@settings(SETTINGS, max_examples=30)
+@given(data=st.data())
+def test_fast_reactions_equal_the_generic_solve_and_balance_every_link(kind, data):
+    """``Dyad.reactions`` (transposed elimination) against ``Group.reactions`` (``(N, 6, 6)``
+    LAPACK solves of ``Phi_q^T lambda = -Q``), and each link's equilibrium ``Phi_q^T lambda + Q = 0``
+    checked with the generic Jacobian."""
+    case = data.draw(cases(kind))
+    group = case.bind()
+    poses, _, _ = case.path(PHI)
+    solution = Group.solve(group, poses, branch=group.branches[0])
+    full = {**poses, **solution.poses}
+    n = len(PHI)
+    rng = np.random.default_rng(data.draw(st.integers(0, 2**32 - 1)))
+    loads = {k: rng.normal(size=(n, 3)) * [1.0, 1.0, case.size] for k in group.links}
+    valid = solution.status == OK
+    fast_lam, fast_out = group.reactions(full, loads, valid=valid)
+    slow_lam, slow_out = Group.reactions(group, full, loads, valid=valid)
+    assert set(fast_lam) == set(slow_lam) and set(fast_out) == set(slow_out)
+    for name in slow_lam:
+        np.testing.assert_array_equal(np.isnan(fast_lam[name]), ~valid[:, None] | np.zeros((1, 2), bool))
+        size = np.maximum(1.0, np.max(np.abs(slow_lam[name][valid]), initial=0.0))
+        np.testing.assert_allclose(fast_lam[name][valid], slow_lam[name][valid], rtol=0,
+                                   atol=1e-9 * size / max(1e-6, float(np.min(solution.conditioning[valid], initial=1))))
+    for k in slow_out:
+        scale = np.maximum(1.0, np.max(np.abs(slow_out[k][valid]), initial=0.0))
+        np.testing.assert_allclose(fast_out[k][valid], slow_out[k][valid], rtol=0,
+                                   atol=1e-9 * scale / max(1e-6, float(np.min(solution.conditioning[valid], initial=1))))
+    phi_q, _ = group.jacobians(full)
+    lam = np.concatenate([fast_lam[j.name] for j in group.joints], axis=1)
+    q = np.concatenate([loads[k] for k in group.links], axis=1)
+    balance = np.einsum("nji,nj->ni", phi_q, lam) + q
+    typical = np.max(np.abs(np.einsum("nji,nj->nji", phi_q, lam)), axis=(1, 2)) + np.max(np.abs(q), axis=1)
+    assert np.all(np.abs(balance[valid]) <= 1e-12 * typical[valid, None])

@@ -94,18 +94,21 @@ class _Counter:
         from assur.dyad import Dyad
 
         self.solves, self.reactions = [], []
-        solve, reactions = Dyad.solve, Group.reactions
+        solve = Dyad.solve
 
         def counted_solve(group, poses, first=None, second=None, *args, **kwargs):
             self.solves.append((repr(group), 0 if first is None else 1 if second is None else 2))
             return solve(group, poses, first, second, *args, **kwargs)
 
-        def counted_reactions(group, *args, **kwargs):
-            self.reactions.append(repr(group))
-            return reactions(group, *args, **kwargs)
+        def counting(reactions):
+            def counted_reactions(group, *args, **kwargs):
+                self.reactions.append(repr(group))
+                return reactions(group, *args, **kwargs)
+            return counted_reactions
 
         monkeypatch.setattr(Dyad, "solve", counted_solve)
-        monkeypatch.setattr(Group, "reactions", counted_reactions)
+        for kind in (Group, Dyad):      # the generic kinetostatics and the dyads' closed form
+            monkeypatch.setattr(kind, "reactions", counting(kind.__dict__["reactions"]))
 
 
 def test_one_point_runs_only_its_ancestors_and_no_derivatives(monkeypatch):
