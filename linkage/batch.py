@@ -27,8 +27,9 @@ from assur.base import OK, RevoluteJoint, global_point, point_analogs
 
 from .assembly import assembly_plans
 from .errors import AssemblyError, InputError
-from .kinematics import JUMP_CHECK_STEP, BranchWarning, _run_blocks, jump_steps, structure_of
+from .kinematics import JUMP_CHECK_STEP, BranchWarning, Motion, _run_blocks, jump_steps, structure_of
 from .model import Mechanism
+from .structure import Structure
 
 __all__ = ["OTHER_BRANCH", "VariantMotion", "analyze_variants", "geometry_of"]
 
@@ -65,6 +66,9 @@ class VariantMotion:
         Variants whose motion passes a singular position or a change point between analysed
         angles (a group changes assembly mode): their values are right for the closed-form
         branch but the motion between the angles is not continuous.
+    structure : Structure
+        The mechanism's structure with pairs that carry every position's geometry (the V n
+        positions flattened variant by variant), for :meth:`flat`.
     """
 
     mechanism: Mechanism
@@ -77,6 +81,7 @@ class VariantMotion:
     conditioning: dict[str, np.ndarray]
     error_bound: np.ndarray
     mode_change: np.ndarray
+    structure: Structure
 
     @property
     def count(self) -> int:
@@ -98,6 +103,17 @@ class VariantMotion:
         d1, d2 = point_analogs(*flat, local)
         shape = (*self.status.shape, 2)
         return d1.reshape(shape), None if d2 is None else d2.reshape(shape)
+
+    def flat(self, omega: ArrayLike | None = None, eps: ArrayLike | None = None) -> Motion:
+        """The batch as one :class:`linkage.Motion` of V n positions (variant by variant; the
+        arrays are views), with the input speed ``omega`` and acceleration ``eps`` given per
+        flattened position ``(V n,)``, for the kinetostatics of the variants."""
+        def flat(values):
+            return None if values is None else {k: v.reshape(-1, 3) for k, v in values.items()}
+
+        return Motion(self.mechanism, self.structure, np.tile(self.phi, self.count), flat(self.poses),
+                      flat(self.first), flat(self.second), self.status.ravel(), omega, eps,
+                      {k: v.ravel() for k, v in self.conditioning.items()}, self.error_bound.ravel())
 
     def _local(self, name: str):
         link = self.mechanism.point_link(name)
@@ -224,7 +240,7 @@ def analyze_variants(
 
     return VariantMotion(mech, local, phi, shaped(run.poses), shaped(run.first), shaped(run.second), status,
                          {k: v.reshape(count, n) for k, v in run.conditioning.items()},
-                         run.error_bound.reshape(count, n), mode_change)
+                         run.error_bound.reshape(count, n), mode_change, structure)
 
 
 # ----------------------------------------------------------------------------------------------

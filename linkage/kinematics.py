@@ -97,9 +97,11 @@ class Motion:
 
     def arm(self, link: str, local) -> np.ndarray:
         """``Rot(theta) p`` ``(N, 2)``, m: the vector from ``link``'s origin to its local point
-        ``p`` ``(2,)`` in global axes, the link's cosines and sines computed once per motion."""
+        ``p`` (``(2,)``, or ``(N, 2)`` per position) in global axes, the link's cosines and sines
+        computed once per motion."""
         _, _, c, s, _ = self.frame(link)
-        return np.column_stack([c * local[0] - s * local[1], s * local[0] + c * local[1]])
+        px, py = xy(local)
+        return np.column_stack([c * px - s * py, s * px + c * py])
 
     def frame(self, link: str) -> tuple[np.ndarray, ...]:
         """``(x, y, cos theta, sin theta, theta)`` of ``link``, each ``(N,)`` (the solvers' link

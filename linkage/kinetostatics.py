@@ -35,7 +35,7 @@ from .errors import InputError
 from .forces import LoadTerm, Loads, evaluate_loads, generalized_loads, inertia_terms, loads_of
 from .kinematics import Motion, angle_in_half_turn, table_positions_deg
 
-__all__ = ["Reactions", "solve_reactions", "virtual_power_residual"]
+__all__ = ["Reactions", "reactions_under", "solve_reactions", "virtual_power_residual"]
 
 
 @dataclass(frozen=True)
@@ -145,23 +145,53 @@ def solve_reactions(
         outputs=...)``). The balancing moment needs the input's pair; without it, it is NaN.
         Default: every pair and the balancing moment.
     """
-    mech, structure = motion.mechanism, motion.structure
+    mech = motion.mechanism
     if motion.second is None:
         raise InputError("reactions need a motion analysed with order=2")
     loads = loads_of(mech) if loads is None else loads
-    group_ids = range(len(structure.groups)) if pairs is None else structure.loading_groups(set(pairs))
-    unknown = set() if pairs is None else set(pairs) - set(structure.joints)
+    links = _links_loaded(motion, pairs)
+    terms = evaluate_loads(motion, loads, ends, links)
+    if inertia and motion.omega is not None:
+        terms += inertia_terms(motion, links)
+    notes = loads.notes + (() if inertia and motion.omega is not None or not inertia else
+                           ("no speed given: inertia loads are zero (static analysis)",))
+    return reactions_under(motion, terms, pairs, notes)
+
+
+def _links_loaded(motion: Motion, pairs: Iterable[str] | None) -> set[str] | None:
+    """The links whose loads the reactions in ``pairs`` need (None: every link), checked
+    against the mechanism's pairs and the links the motion places."""
+    structure = motion.structure
+    if pairs is None:
+        return None
+    unknown = set(pairs) - set(structure.joints)
     if unknown:
-        raise InputError(f"mechanism '{mech.name}' has no pair(s) {sorted(unknown)} (pairs {sorted(structure.joints)})")
+        raise InputError(f"mechanism '{motion.mechanism.name}' has no pair(s) {sorted(unknown)} "
+                         f"(pairs {sorted(structure.joints)})")
+    group_ids = structure.loading_groups(set(pairs))
     everything = len(group_ids) == len(structure.groups)
     links = {k for i in group_ids for k in structure.groups[i].links} | (set(structure.inputs) if everything else set())
     missing = sorted(links - set(motion.poses))
     if missing:
         raise InputError(f"the reactions asked for need links {missing}, which the motion does not place "
                          "(analyze them: outputs=...)")
-    terms = evaluate_loads(motion, loads, ends, None if everything else links)
-    if inertia and motion.omega is not None:
-        terms += inertia_terms(motion, None if everything else links)
+    return None if everything else links
+
+
+def reactions_under(motion: Motion, terms: list[LoadTerm], pairs: Iterable[str] | None = None,
+                    notes: tuple[str, ...] = ()) -> Reactions:
+    """Reactions and the balancing moment under load terms already evaluated at the motion's
+    positions (:func:`solve_reactions` evaluates the mechanism's declared loads first; a
+    batch of variants gives its own, :func:`linkage.batch_reactions.variant_reactions`).
+
+    ``terms`` must hold the loads on every link the reactions in ``pairs`` need (default: every
+    pair and the balancing moment).
+    """
+    if motion.second is None:
+        raise InputError("reactions need a motion analysed with order=2")
+    structure = motion.structure
+    everything = _links_loaded(motion, pairs) is None
+    group_ids = range(len(structure.groups)) if pairs is None else structure.loading_groups(set(pairs))
     applied = generalized_loads(motion, terms)
     multipliers: dict[str, np.ndarray] = {}
     valid = motion.status == OK
@@ -173,8 +203,8 @@ def solve_reactions(
         for link, load in transmitted.items():
             applied[link] = applied[link] + load
     if not everything:
-        notes = loads.notes + ("balancing moment not computed: only the reactions in pairs "
-                               f"{sorted(pairs)} were asked for",)
+        notes = notes + ("balancing moment not computed: only the reactions in pairs "
+                         f"{sorted(pairs)} were asked for",)
         return Reactions(motion, multipliers, np.full(len(motion.phi), np.nan), terms, notes)
     (link,) = structure.inputs
     joint = structure.input_joints[link]
@@ -188,8 +218,6 @@ def solve_reactions(
     if bad.any():
         balancing = np.where(bad, np.nan, balancing)
         multipliers = {k: np.where(bad[:, None], np.nan, v) for k, v in multipliers.items()}
-    notes = loads.notes + (() if inertia and motion.omega is not None or not inertia else
-                           ("no speed given: inertia loads are zero (static analysis)",))
     return Reactions(motion, multipliers, balancing, terms, notes)
 
 
