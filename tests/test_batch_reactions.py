@@ -28,7 +28,8 @@ def with_masses_and_force(text: str, coupler_mass: float, rocker_inertia: float,
     ab = float(text.split("length = ")[2].split()[0])
     for old, new in (("mass = 3.0\n", f"mass = {coupler_mass!r}\n"),
                      ("inertia = 0.0104167\n", f"inertia = {rocker_inertia!r}\n"),
-                     ('points.S2 = { from = "A", distance = 0.15 }', f'points.S2 = {{ from = "A", distance = {ab / 2!r} }}')):
+                     ('points.S2 = { from = "A", distance = 0.15 }',
+                      f'points.S2 = {{ from = "A", distance = {ab / 2!r} }}')):
         assert old in text
         text = text.replace(old, new)
     return text + f'\n[[loads.forces]]\npoint = "E"\nlink = "2"\nforce = [{force[0]!r}, {force[1]!r}]\n'
@@ -73,9 +74,9 @@ def test_slider_crank_balancing_moment_equals_virtual_work_in_closed_form():
     force = np.stack([P, np.zeros_like(P)], axis=-1)
     got = variant_reactions(batch, mass={k: 0.0 for k in ("1", "2", "3")}, inertia={"2": 0.0},
                             gravity=[0.0, 0.0], forces={"3": {"B": force}})
-    r, l = cranks[:, None], rods[:, None]
+    r, rod = cranks[:, None], rods[:, None]
     h = r * np.sin(phi) - e
-    dx = -r * np.sin(phi) - h * r * np.cos(phi) / np.sqrt(l**2 - h**2)
+    dx = -r * np.sin(phi) - h * r * np.cos(phi) / np.sqrt(rod**2 - h**2)
     np.testing.assert_allclose(got.balancing_moment, -P * dx, rtol=1e-12, atol=1e-12 * np.max(np.abs(P * dx)))
     assert "static analysis" in got.flat.notes[-1]
     # the slider's guide carries the rod's force normal to it: R[0, 3] balances the rod on the slider
