@@ -315,17 +315,23 @@ class Group(ABC):
         return f"{self.group_class}-{self.kind}({','.join(self.links)})"
 
     # -- position ------------------------------------------------------------------------------
-    def position(self, poses: Poses, branch: int = 1, input_error=0.0) -> GroupPosition:
+    def position(self, poses: Poses, branch: int = 1, input_error=0.0, start: Poses | None = None) -> GroupPosition:
         """Poses of the group's links given the known ``poses``; checks closure and singularity.
 
         A position is singular (status -2) where the bound of the relative error of the first
         analogs, ``ROUNDOFF_FACTOR * eps / r**2 + input_error / r`` for the group's
         :meth:`conditioning` r, exceeds ``ANALOG_TOL``: the group's own round-off plus the error
         of the known links' analogs (``input_error``, scalar or ``(N,)``) amplified by the solve.
+        ``start``: poses of the group's links near the wanted solution, for kinds solved
+        iteratively (:class:`assur.generic.NewtonGroup`); closed forms do not use it.
         """
         if branch not in self.branches:
             raise ValueError(f"{self!r}: branch must be one of {self.branches}, got {branch!r}")
         new, assembled = self._position(poses, branch)
+        return self._checked(poses, new, assembled, input_error)
+
+    def _checked(self, poses: Poses, new: dict, assembled: np.ndarray, input_error=0.0) -> GroupPosition:
+        """The closure and singularity checks of :meth:`position` on placed poses ``new``."""
         merged = {**poses, **new}
         residual = self.residual(merged)
         closure = np.max(np.abs(residual), axis=1) if residual.size else np.zeros(len(assembled))
@@ -472,16 +478,17 @@ class Group(ABC):
         return d1, self._split(q2)
 
     def solve(self, poses: Poses, first: Poses | None = None, second: Poses | None = None, branch: int = 1,
-              input_error=0.0, frames=None, out=None) -> GroupSolution:
+              input_error=0.0, frames=None, out=None, start: Poses | None = None) -> GroupSolution:
         """Positions, statuses and analogs in one call: :meth:`position` then :meth:`analogs`.
 
         ``first`` (and ``second``) are the analogs of the known links; without them only
         positions are solved. ``out``: ``(poses, first, second)``, dicts of ``(N, 3)`` arrays
         (or None) that receive the group's results. ``frames`` (a cache of link frames shared
-        by the fast paths) is not used here. Kinds with a fast path (the dyads) override this
-        with the same results computed elementwise; this generic version is their oracle.
+        by the fast paths) is not used here; ``start``: see :meth:`position`. Kinds with a fast
+        path (the dyads) override this with the same results computed elementwise; this generic
+        version is their oracle.
         """
-        placed = self.position(poses, branch, input_error)
+        placed = self.position(poses, branch, input_error, start)
         d1 = d2 = None
         if first is not None:
             d1, d2 = self.analogs({**poses, **placed.poses}, first, second, valid=placed.status == OK)

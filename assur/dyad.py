@@ -53,7 +53,7 @@ class Dyad(Group):
 
     # -- the fast path ------------------------------------------------------------------------
     def solve(self, poses, first=None, second=None, branch: int = 1, input_error=0.0,
-              frames=None, out=None) -> GroupSolution:
+              frames=None, out=None, start=None) -> GroupSolution:
         """:meth:`Group.solve` in closed form: the same statuses, conditioning, bounds and analogs.
 
         The six unknowns of the analog systems are eliminated pair by pair: each external pair
@@ -62,7 +62,7 @@ class Dyad(Group):
         the determinant of the group Jacobian). ``frames`` may carry the known links' frames
         (:func:`assur.rows.frame`) computed once for every group that uses them; it receives the
         group's own frames. ``out``: ``(poses, first, second)`` dicts of ``(N, 3)`` arrays to write
-        the group's results into (see :meth:`Group.solve`).
+        the group's results into (see :meth:`Group.solve`). ``start`` is not used (closed form).
         """
         if branch not in self.branches:
             raise ValueError(f"{self!r}: branch must be one of {self.branches}, got {branch!r}")

@@ -5,11 +5,13 @@ from __future__ import annotations
 from typing import Sequence
 
 from .base import Group, Joint
+from .generic import NewtonGroup
 from .prp import PRP
 from .rpp import RPP
 from .rpr import RPR
 from .rrp import RRP
 from .rrr import RRR
+from .triad import Triad
 
 __all__ = ["GROUP_KINDS", "group_kind", "register", "solver_for"]
 
@@ -22,7 +24,8 @@ def register(cls: type[Group]) -> type[Group]:
     return cls
 
 
-for _cls in (RRR, RRP, RPR, PRP, RPP):
+# the closed forms first; the generic Newton solver binds every statically determinate group left
+for _cls in (RRR, RRP, RPR, PRP, RPP, Triad, NewtonGroup):
     register(_cls)
 
 

@@ -64,6 +64,31 @@ class BranchPlan:
     mode: str
     change_points: np.ndarray
     swaps: np.ndarray
+    track: tuple[np.ndarray, dict[str, np.ndarray]] | None = None
+
+    def start(self, phi: np.ndarray) -> dict[str, np.ndarray] | None:
+        """Start poses ``{link: (N, 3)}`` at the input angles ``phi`` for a group solved by
+        Newton's method: its chosen assembly mode traced over the plan's sweep, interpolated
+        (NaN where the mode does not exist); ``None`` for closed forms."""
+        if self.track is None:
+            return None
+        sweep, poses = self.track
+        phi = np.asarray(phi, dtype=float)
+        full_turn = np.isclose(sweep[-1] - sweep[0] + (sweep[1] - sweep[0]), TWO_PI)
+        if full_turn:
+            at = (phi - sweep[0]) % TWO_PI + sweep[0]
+            sweep = np.append(sweep, sweep[0] + TWO_PI)
+            poses = {k: np.vstack([v, v[:1]]) for k, v in poses.items()}
+        else:
+            at = np.where((phi >= sweep[0] - 1e-12) & (phi <= sweep[-1] + 1e-12), phi, np.nan)
+        out = {}
+        for k, v in poses.items():
+            theta = v[:, 2].copy()
+            finite = np.isfinite(theta)
+            theta[finite] = np.unwrap(theta[finite])
+            columns = [np.interp(at, sweep, v[:, 0]), np.interp(at, sweep, v[:, 1]), np.interp(at, sweep, theta)]
+            out[k] = np.column_stack(columns)
+        return out
 
     def branches(self, phi: np.ndarray) -> np.ndarray:
         """Closed-form branch ``(N,)`` at the (unwrapped) input angles ``phi``."""
@@ -90,16 +115,16 @@ class BranchPlan:
 
 
 def place_group(group: Group, poses, branches, input_error=0.0, first=None, second=None,
-                frames=None, out=None) -> GroupSolution:
+                frames=None, out=None, start=None) -> GroupSolution:
     """:meth:`Group.solve` with a branch per position ``(N,)`` (each branch solved where it is
     used), or one branch (int) for all.
 
-    ``first`` / ``second``: analogs of the known links (``None``: positions only); ``frames`` and
-    ``out``: see :meth:`assur.base.Group.solve`.
+    ``first`` / ``second``: analogs of the known links (``None``: positions only); ``frames``,
+    ``out`` and ``start`` (:meth:`BranchPlan.start`): see :meth:`assur.base.Group.solve`.
     """
     values = np.unique(branches)
     if len(values) == 1:
-        return group.solve(poses, first, second, int(values[0]), input_error, frames=frames, out=out)
+        return group.solve(poses, first, second, int(values[0]), input_error, frames=frames, out=out, start=start)
     parts = {int(b): group.solve(poses, first, second, int(b), input_error) for b in values}
 
     def pick(get):
@@ -161,6 +186,11 @@ def assembly_plans(mech: Mechanism) -> tuple[BranchPlan, ...]:
     plans: list[BranchPlan] = []
     for i, group in enumerate(structure.groups):
         rule = rules.get(i)
+        if getattr(group, "tracked", False):
+            plan = _traced_plan(mech, structure, plans, i, rule, poses, phi)
+            plans.append(plan)
+            poses.update(place_group(group, poses, 1, start=plan.start(phi)).poses)
+            continue
         mode = rule.mode if rule is not None else "keep"
         # the first branch's placement: both branches of a closed form assemble at the same angles
         first = group.position(poses, group.branches[0])
@@ -225,9 +255,9 @@ def _rules_per_group(mech: Mechanism, structure: Structure) -> dict:
     problems = []
     for rule in mech.assembly:
         owners = [i for i, g in enumerate(structure.groups)
-                  if len(g.branches) > 1 and any(rule.point in mech.links[k].points for k in g.links)]
+                  if _has_modes(g) and any(rule.point in mech.links[k].points for k in g.links)]
         if not owners:
-            problems.append(f"assembly of point '{rule.point}': no group with two assembly branches "
+            problems.append(f"assembly of point '{rule.point}': no group with two or more assembly modes "
                             "places this point")
         elif owners[0] in rules:
             problems.append(f"assembly of point '{rule.point}': group {structure.groups[owners[0]]!r} "
@@ -235,13 +265,18 @@ def _rules_per_group(mech: Mechanism, structure: Structure) -> dict:
         else:
             rules[owners[0]] = rule
     for i, g in enumerate(structure.groups):
-        if len(g.branches) > 1 and i not in rules:
+        if _has_modes(g) and i not in rules:
             pts = sorted({p for k in g.links for p in mech.links[k].points})
-            problems.append(f"group {g!r} has two assembly branches: declare which one with an "
-                            f"assembly condition on one of its points {pts}")
+            problems.append(f"group {g!r} has {'two assembly branches' if len(g.branches) > 1 else 'several assembly modes'}"
+                            f": declare which one with an assembly condition on one of its points {pts}")
     if problems:
         raise SchemeError([f"mechanism '{mech.name}': {p}" for p in problems])
     return rules
+
+
+def _has_modes(group) -> bool:
+    """Whether the group can be assembled in more than one way (a condition must choose)."""
+    return len(group.branches) > 1 or getattr(group, "tracked", False)
 
 
 def _rule_score(mech: Mechanism, rule, poses) -> np.ndarray:
@@ -265,6 +300,140 @@ def _rule_score(mech: Mechanism, rule, poses) -> np.ndarray:
 
 
 # ----------------------------------------------------------------------------------------------
+# groups solved by Newton's method: their modes traced over the sweep
+# ----------------------------------------------------------------------------------------------
+
+#: multi-start guesses at the first angle for a group that cannot list its modes
+STARTS = 64
+#: a traced mode ends where its nearest solution at the next sweep angle is farther than this
+#: fraction of the mechanism's size (the mode ceased to exist there)
+TRACE_JUMP = 0.1
+
+
+def _traced_plan(mech, structure, plans, i, rule, poses, phi) -> BranchPlan:
+    """The plan of a group solved by Newton's method: each assembly mode found at the sweep's
+    angles and followed from angle to angle (nearest listed solution, or Newton's method from the
+    previous angle); the declared condition chooses one (as for two branches)."""
+    group = structure.groups[i]
+    known = {k: poses[k] for k in group.known_links}
+    listed = group.modes(known)
+    traces = _linked(group, listed) if listed is not None else _continued(group, known)
+    traces = _distinct(group, traces)
+    if not traces:
+        _never_assembles(mech, group, known)
+    if len(traces) == 1 and rule is None:
+        chosen = 0
+    else:
+        scores = []
+        for trace in traces:
+            trial = {**poses, **trace}
+            score = _rule_score(mech, rule, trial)
+            if rule.phi is not None:
+                near = int(np.argmin(np.abs((phi - rule.phi + np.pi) % TWO_PI - np.pi)))
+                score = score[near:near + 1]
+            with np.errstate(invalid="ignore"):
+                scores.append(int(np.sum(score > 1e-9 * mech.size)))
+        order = np.argsort(scores)[::-1]
+        if len(traces) > 1 and scores[order[0]] == scores[order[1]]:
+            raise SchemeError(
+                f"mechanism '{mech.name}': assembly of point '{rule.point}' ({_describe(rule)}) does not tell "
+                f"the assembly modes of {group!r} apart (two of its {len(traces)} modes satisfy it at "
+                f"{scores[order[0]]} of {len(phi)} input angles; choose a condition that only one mode meets)")
+        chosen = int(order[0])
+    return BranchPlan(1, "keep", np.empty(0), np.empty(0, bool), (phi.copy(), traces[chosen]))
+
+
+def _linked(group, listed) -> list[dict[str, np.ndarray]]:
+    """Modes followed over the sweep from the listed solutions ``({link: (M, K, 3)}, valid (M, K))``."""
+    candidates, valid = listed
+    M = len(valid)
+    present = np.flatnonzero(valid.any(axis=1))
+    if not len(present):
+        return []
+    first = int(present[0])
+    size = float(np.max(group.size))
+    traces = []
+    for slot in np.flatnonzero(valid[first]):
+        trace = {k: np.full((M, 3), np.nan) for k in candidates}
+        current = {k: v[first, slot] for k, v in candidates.items()}
+        for k in candidates:
+            trace[k][first] = current[k]
+        for step in range(1, M):
+            m = (first + step) % M
+            gap = sum(_pose_distance(v[m], current[k], size) ** 2 for k, v in candidates.items())
+            gap = np.where(valid[m], np.sqrt(gap), np.inf)
+            best = int(np.argmin(gap))
+            if not np.isfinite(gap[best]) or gap[best] > TRACE_JUMP * size:
+                break
+            current = {k: v[m, best] for k, v in candidates.items()}
+            for k in candidates:
+                trace[k][m] = current[k]
+        traces.append(trace)
+    return traces
+
+
+def _continued(group, known) -> list[dict[str, np.ndarray]]:
+    """Modes found by Newton's method from many starts at the first sweep angle and continued from
+    each angle to the next (a mode ends where Newton's method fails)."""
+    from assur.generic import newton
+
+    M = len(next(iter(known.values())))
+    size = float(np.max(group.size))
+    rng = np.random.default_rng(0)
+    at0 = {k: np.repeat(v[:1], STARTS, axis=0) for k, v in known.items()}
+    anchors = group.contact_points({**{k: v[:1] for k, v in known.items()},
+                                    **{k: np.zeros((1, 3)) for k in group.links}})
+    centre = np.nanmean(anchors[0], axis=0)
+    guesses = {k: np.column_stack([centre[0] + size * rng.uniform(-1, 1, STARTS),
+                                   centre[1] + size * rng.uniform(-1, 1, STARTS),
+                                   rng.uniform(-np.pi, np.pi, STARTS)]) for k in group.links}
+    solved, converged = newton(group, at0, guesses)
+    closure = np.max(np.abs(group.residual({**at0, **solved})), axis=1)
+    with np.errstate(invalid="ignore"):
+        good = converged & (closure <= 1e-9 * size)
+    starts = [{k: v[n] for k, v in solved.items()} for n in np.flatnonzero(good)]
+    starts = [t for t in _distinct(group, [{k: v[None] for k, v in s.items()} for s in starts])]
+    if not starts:
+        return []
+    count = len(starts)
+    traces = {k: np.full((M, count, 3), np.nan) for k in group.links}
+    for k in group.links:
+        traces[k][0] = np.concatenate([s[k] for s in starts])
+    for m in range(1, M):
+        here = {k: np.repeat(v[m:m + 1], count, axis=0) for k, v in known.items()}
+        solved, converged = newton(group, here, {k: traces[k][m - 1] for k in group.links})
+        moved = sum(_pose_distance(solved[k], traces[k][m - 1], size) ** 2 for k in group.links)
+        keep = converged & (np.sqrt(moved) <= TRACE_JUMP * size)
+        for k in group.links:
+            traces[k][m] = np.where(keep[:, None], solved[k], np.nan)
+    return [{k: traces[k][:, c] for k in group.links} for c in range(count)]
+
+
+def _distinct(group, traces) -> list[dict[str, np.ndarray]]:
+    """Traces with the ones that coincide with an earlier one (at every angle both exist) removed."""
+    size = float(np.max(group.size))
+    kept = []
+    for trace in traces:
+        same = False
+        for other in kept:
+            gap = np.sqrt(sum(_pose_distance(trace[k], other[k], size) ** 2 for k in trace))
+            both = np.isfinite(gap)
+            if both.any() and np.all(gap[both] <= 1e-6 * size):
+                same = True
+                break
+        if not same:
+            kept.append(trace)
+    return kept
+
+
+def _pose_distance(a: np.ndarray, b: np.ndarray, size: float) -> np.ndarray:
+    """Distance between poses ``(..., 3)``, m (angles weighted by ``size``, wrapped)."""
+    d = a - b
+    turn = (d[..., 2] + np.pi) % TWO_PI - np.pi
+    return np.sqrt(d[..., 0] ** 2 + d[..., 1] ** 2 + (size * turn) ** 2)
+
+
+# ----------------------------------------------------------------------------------------------
 # change points
 # ----------------------------------------------------------------------------------------------
 
@@ -275,7 +444,7 @@ def _chain(mech, structure, plans, i, phi):
 
     poses = input_poses(mech, structure, phi)
     for j in structure.needed_groups(structure.groups[i].known_links):
-        poses.update(place_group(structure.groups[j], poses, plans[j].branches(phi)).poses)
+        poses.update(place_group(structure.groups[j], poses, plans[j].branches(phi), start=plans[j].start(phi)).poses)
     return poses
 
 

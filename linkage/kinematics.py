@@ -448,7 +448,8 @@ def _run_blocks(mech: Mechanism, structure: Structure, plans, group_ids: list[in
             group = structure.groups[i]
             incoming = _largest([link_error[k] for k in group.known_links])
             branch = branches[i] if isinstance(branches[i], int) else branches[i][block]
-            got = place_group(group, view, branch, incoming, view1, view2, frames, (view, view1, view2))
+            got = place_group(group, view, branch, incoming, view1, view2, frames, (view, view1, view2),
+                              plans[i].start(phi[block]))
             for k in group.links:
                 link_error[k] = got.error_bound
             conditioning[repr(group)][block] = got.conditioning

@@ -34,6 +34,9 @@ EXPECTED_FORMULAS = {
     "slider_crank_vertical": "I(0,1) → II-RRP(2,3)",
     "slotted_link": "I(0,1) → II-RPR(2,3)",
     "slotted_link_two_dyad": "I(0,1) → II-RPR(2,3) → II-PRP(4,5)",
+    "six_bar_class3": "I(0,1) → III(2,3,4,5)",         # legs 2, 4, 5 on the ternary link 3
+    "watt_six_bar": "I(0,1) → II-RRR(2,3) → II-RRR(4,5)",
+    "stephenson_six_bar": "I(0,1) → II-RRR(2,3) → II-RRR(4,5)",
 }
 
 SCHEMES = sorted(linkage.shipped_schemes())

@@ -44,6 +44,9 @@ HAND_MOBILITY = {
     "slotted_link": 3 * 3 - 2 * 4,           # links 1 2 3; pairs O1 A slot O3
     "six_bar": 3 * 5 - 2 * 7,                # links 1..5; pairs O A B C D F slide
     "slotted_link_two_dyad": 3 * 5 - 2 * 7,  # links 1..5; pairs O1 A slot_A O3 slot_B B ram
+    "six_bar_class3": 3 * 5 - 2 * 7,         # links 1..5; pairs O A B C D E F
+    "watt_six_bar": 3 * 5 - 2 * 7,           # links 1..5; seven revolute pairs
+    "stephenson_six_bar": 3 * 5 - 2 * 7,     # links 1..5; seven revolute pairs
 }
 
 #: structural formulas derived by hand from the scheme files (docs/methods.md#structure)
@@ -57,6 +60,11 @@ HAND_FORMULA = {
     "six_bar": "I(0,1) → II-RRR(2,3) → II-RRP(4,5)",
     "course_slider_crank": "I(0,1) → II-RRP(2,3)",
     "slotted_link_two_dyad": "I(0,1) → II-RPR(2,3) → II-PRP(4,5)",
+    # legs 2 (A, B), 4 (C, E), 5 (D, F) on the ternary link 3 (B, C, D): no two links form a dyad
+    "six_bar_class3": "I(0,1) → III(2,3,4,5)",
+    # a crank-rocker (2, 3) first; its plate drives the second dyad (4, 5)
+    "watt_six_bar": "I(0,1) → II-RRR(2,3) → II-RRR(4,5)",
+    "stephenson_six_bar": "I(0,1) → II-RRR(2,3) → II-RRR(4,5)",
 }
 
 
@@ -284,8 +292,9 @@ def test_not_decomposable_structure_error():
         linkage.decompose(mech)
 
 
-def test_class_three_group_names_its_links():
-    """A crank driving a triad (ternary link T, binary links 2, 3, 4): no registered solver."""
+def test_class_three_group_is_decomposed_and_written_in_the_formula():
+    """A crank driving a triad (ternary link T, binary links 2, 3, 4): one class-III group,
+    whatever the order of declaration."""
     b = MechanismBuilder("triad")
     b.link("0", points={"O": (0.0, 0.0), "D": (0.5, 0.0), "G": (0.25, 0.5)})
     b.link("1", line=("O", "A"), length=0.1)
@@ -298,8 +307,9 @@ def test_class_three_group_names_its_links():
         b.revolute(pair, x, y)
     mech = b.inputs("1").build()
     assert linkage.mobility(mech) == 3 * 5 - 2 * 7 == 1
-    with pytest.raises(StructureError, match=r"\['2', '3', '4', 'T'\]"):
-        linkage.decompose(mech)
+    structure = linkage.decompose(mech)
+    assert structure.formula == "I(0,1) → III(2,3,4,T)"
+    assert structure.groups[0].group_class == "III" and structure.groups[0].kind == "RRR-RRR"
 
 
 # ----------------------------------------------------------------------------------------------

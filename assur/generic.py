@@ -1,0 +1,199 @@
+"""The generic group solver: Newton's method on any statically determinate group's constraints.
+
+A group that no closed-form kind binds -- a class-III triad, a class-IV group, a group with
+prismatic pairs in any arrangement -- is solved by Newton's method on its constraint equations
+``Phi(q) = 0`` with the analytic Jacobian the group protocol builds (:meth:`Group.jacobians`),
+started from a *start*: poses of the group's links near the wanted solution. The start comes from
+the group's assembly plan (:mod:`linkage.assembly`): the chosen assembly mode, traced over a sweep
+of the input angle by continuation, interpolated at each analysed angle; Newton only polishes it.
+Everything else -- the closure and singularity checks, the exact analogs, the kinetostatics -- is
+the shared generic path of :class:`assur.base.Group`.
+
+A group kind that can list all its assembly modes in closed form (the RRR triad,
+:mod:`assur.triad`) overrides :meth:`NewtonGroup.modes`; then the plan traces every mode and the
+analysis picks the listed solution nearest to the start.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .base import SINGULAR, Group, GroupPosition, Poses
+
+__all__ = ["NewtonGroup", "NEWTON_STEPS", "newton", "group_class_of"]
+
+#: most Newton steps per solve
+NEWTON_STEPS = 40
+#: converged when the step is below this fraction of the mechanism's size (angles: rad)
+STEP_TOL = 1e-13
+
+
+def group_class_of(links, joints) -> str:
+    """Assur's class of a group as a Roman numeral: the number of sides of the largest closed
+    contour its internal pairs form (IV, V, ...), else III when a link has three internal pairs
+    (a triad), else II."""
+    inner = [j for j in joints if j.a in links and j.b in links]
+    neighbours = {k: {j.b if j.a == k else j.a for j in inner if k in (j.a, j.b)} for k in links}
+    longest = 0
+
+    def walk(path):
+        nonlocal longest
+        for nxt in neighbours[path[-1]]:
+            if nxt == path[0] and len(path) >= 3:
+                longest = max(longest, len(path))
+            elif nxt not in path:
+                walk(path + [nxt])
+
+    for k in links:
+        walk([k])
+    if longest >= 4:
+        return _roman(longest)
+    if any(len(n) >= 3 for n in neighbours.values()):
+        return "III"
+    return "II"
+
+
+def _roman(n: int) -> str:
+    return {4: "IV", 5: "V", 6: "VI", 7: "VII", 8: "VIII"}.get(n, str(n))
+
+
+def newton(group: Group, poses: Poses, start: Poses, steps: int = NEWTON_STEPS):
+    """Newton's method on ``group``'s constraints from the ``start`` poses of its links.
+
+    Parameters
+    ----------
+    poses : dict of link -> ndarray (N, 3)
+        Poses of the known links.
+    start : dict of link -> ndarray (N, 3)
+        Start poses of the group's links.
+
+    Returns
+    -------
+    solved : dict of link -> ndarray (N, 3)
+        The poses reached.
+    converged : ndarray of bool (N,)
+        Where the last step was below ``STEP_TOL`` times the size (rad for angles).
+    """
+    links = group.links
+    q = np.concatenate([np.asarray(start[k], float) for k in links], axis=1).copy()
+    N = len(q)
+    size = np.broadcast_to(np.asarray(group.size, float), (N,))
+    active = np.all(np.isfinite(q), axis=1)
+    converged = np.zeros(N, bool)
+    angles = np.zeros(q.shape[1], bool)
+    angles[2::3] = True
+    for _ in range(steps):
+        if not active.any():
+            break
+        rows = np.flatnonzero(active)
+        current = {**{k: v[rows] for k, v in poses.items()}, **_split(q[rows], links)}
+        residual = np.concatenate([j.residual(current) for j in group.joints], axis=1)
+        phi_q, _ = group.jacobians(current)
+        step, solvable = _solve(phi_q, -residual)
+        # damping: no step moves a point by more than half the size or turns a link by more than 0.5 rad
+        scale = np.where(angles, 0.5, 0.5 * size[rows, None])
+        with np.errstate(invalid="ignore", divide="ignore"):
+            factor = np.min(np.where(np.abs(step) > scale, scale / np.abs(step), 1.0), axis=1)
+        step *= factor[:, None]
+        q[rows] += np.where(solvable[:, None], step, 0.0)
+        small = np.max(np.abs(step) / np.where(angles, 1.0, size[rows, None]), axis=1) <= STEP_TOL
+        done = solvable & small & (factor == 1.0)
+        converged[rows[done]] = True
+        active[rows[done | ~solvable | ~np.all(np.isfinite(q[rows]), axis=1)]] = False
+    return _split(q, links), converged
+
+
+def _solve(a: np.ndarray, b: np.ndarray):
+    """Batched ``a x = b`` ``(N, m, m)``, ``(N, m)``; ``(x, solvable)`` where exactly singular or
+    non-finite systems give ``x = 0`` and ``solvable = False``."""
+    solvable = np.all(np.isfinite(a), axis=(1, 2)) & np.all(np.isfinite(b), axis=1)
+    a = np.where(solvable[:, None, None], a, np.eye(a.shape[1]))
+    b = np.where(solvable[:, None], b, 0.0)
+    try:
+        return np.linalg.solve(a, b[..., None])[..., 0], solvable
+    except np.linalg.LinAlgError:
+        x = np.zeros_like(b)
+        for n in range(len(a)):
+            try:
+                x[n] = np.linalg.solve(a[n], b[n])
+            except np.linalg.LinAlgError:
+                solvable[n] = False
+        return x, solvable
+
+
+def _split(q: np.ndarray, links) -> dict[str, np.ndarray]:
+    return {k: q[:, 3 * i:3 * i + 3] for i, k in enumerate(links)}
+
+
+class NewtonGroup(Group):
+    """Any statically determinate group of revolute and prismatic pairs, solved by Newton's method
+    from a start (see the module docstring). The registry tries it after the closed forms."""
+
+    kind = "N"
+    tracked = True      # its assembly plan traces its modes over a sweep and gives starts
+
+    def __init__(self, links, joints, size=1.0):
+        super().__init__(links, joints, size)
+        self.group_class = group_class_of(self.links, self.joints)
+
+    @classmethod
+    def _bind(cls, links, joints, known, size):
+        return cls(links, joints, size) if 3 * len(links) == 2 * len(joints) and len(links) >= 2 else None
+
+    def __repr__(self) -> str:
+        return f"{self.group_class}({','.join(sorted(self.links, key=_natural))})"
+
+    def modes(self, poses: Poses):
+        """Hook: every assembly mode at each position, ``({link: (N, K, 3)}, valid (N, K))``, or
+        ``None`` when the kind cannot list them (the plan then finds them by Newton's method from
+        many starts at the first angle and continues them)."""
+        return None
+
+    def position(self, poses: Poses, branch: int = 1, input_error=0.0, start: Poses | None = None) -> GroupPosition:
+        """:meth:`Group.position` from ``start`` (the poses of the group's links near the wanted
+        assembly mode, ``(N, 3)`` each; rows with NaN: no start, status -1). Where the kind lists
+        its modes, the listed solution nearest to the start is polished; the position is singular
+        (-2) when a second mode is nearly as near (the start cannot tell them apart)."""
+        if start is None:
+            raise ValueError(f"{self!r} is solved by Newton's method and needs start poses (its assembly plan)")
+        ambiguous = None
+        listed = self.modes(poses)
+        if listed is not None:
+            start, ambiguous = _nearest(self, listed, start)
+        solved, converged = newton(self, poses, start)
+        finite = np.all(np.isfinite(np.concatenate(list(solved.values()), axis=1)), axis=1)
+        placed = self._checked(poses, solved, converged & finite, input_error)
+        if ambiguous is not None and ambiguous.any():
+            status = np.where(ambiguous & (placed.status == 0), SINGULAR, placed.status)
+            placed = GroupPosition(placed.poses, status, placed.jacobian_sign, placed.conditioning, placed.error_bound)
+        return placed
+
+    def _position(self, poses: Poses, branch: int):
+        raise ValueError(f"{self!r} is solved by Newton's method from start poses: call position(..., start=...)")
+
+
+def _nearest(group: NewtonGroup, listed, start):
+    """The listed mode nearest to ``start`` at each position, and where a second mode is within
+    twice that distance plus round-off (ambiguous)."""
+    candidates, valid = listed
+    N, K = valid.shape
+    reference = np.stack([start[k] for k in group.links], axis=1)          # (N, L, 3)
+    options = np.stack([candidates[k] for k in group.links], axis=2)       # (N, K, L, 3)
+    size = np.broadcast_to(np.asarray(group.size, float), (N,))
+    difference = options - reference[:, None]
+    difference[..., 2] = (difference[..., 2] + np.pi) % (2 * np.pi) - np.pi
+    difference[..., 2] *= size[:, None, None]
+    with np.errstate(invalid="ignore"):
+        distance = np.where(valid, np.sqrt(np.sum(difference**2, axis=(2, 3))), np.inf)
+    order = np.argsort(distance, axis=1)
+    best, second = order[:, 0], order[:, 1] if K > 1 else order[:, 0]
+    rows = np.arange(N)
+    d1, d2 = distance[rows, best], distance[rows, second] if K > 1 else np.full(N, np.inf)
+    found = np.isfinite(d1) & np.all(np.isfinite(reference), axis=(1, 2))
+    chosen = {k: np.where(found[:, None], candidates[k][rows, best], np.nan) for k in group.links}
+    ambiguous = found & (d2 < 2.0 * d1 + 1e-9 * size)
+    return chosen, ambiguous
+
+
+def _natural(name: str):
+    return (0, int(name), "") if name.isdigit() else (1, 0, name)
