@@ -182,7 +182,8 @@ def test_a_group_without_closed_form_is_solved_by_newton_from_many_starts():
                         'angle_deg = -29.47588900324573 }')
     start, end = text.index("[links.5]"), text.index("[pairs.O]")
     text = text[:start] + '[links.5]\npoints.D = [0.0, 0.0]\nmass = 1.0\ncom = "D"\n\n' + text[end:]
-    text = text.replace('[pairs.F]\nlinks = ["5", "0"]', '[pairs.F]\nkind = "P"\nlinks = ["0", "5"]\nguide = "way"\nat = "D"')
+    text = text.replace('[pairs.F]\nlinks = ["5", "0"]',
+                        '[pairs.F]\nkind = "P"\nlinks = ["0", "5"]\nguide = "way"\nat = "D"')
     text = text.replace('input = "1"', 'input = "1"\nrange_deg = [0, 100]')
     # its two modes (B at (0.10, 0.15) or about (0.117, 0.143) when phi = 0) both have D left of F -> C
     text = text.replace('[assembly.D]', '[assembly.B]').replace('left_of = ["F", "C"]', 'from = "A"\ntowards_deg = 158')
