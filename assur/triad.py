@@ -9,11 +9,11 @@ Geometry: leg i joins the known point ``A_i`` (carried by a known link) to the t
 
 for i = 2, 3: a linear system in ``(cos a, sin a)``. Its solution ``(C, S) / D`` (Cramer) lies on
 the unit circle where ``f(t) = C^2 + S^2 - D^2 = 0``. ``w_i`` and ``h_i`` are of degree 1 in
-``(cos t, sin t)``, so ``f`` is a trigonometric polynomial of degree 4: with ``z = e^{i t}``,
-``z^4 f`` is a polynomial of degree 8 whose roots on the unit circle are the assembly modes (at
-most six are real for a triad). Its coefficients are the discrete Fourier transform of ``f`` at
-16 angles (exact for degree 4); its roots are the eigenvalues of the companion matrix, for all
-positions at once.
+``(cos t, sin t)``, so ``f`` is a trigonometric polynomial of degree at most 4 (its degree-4 terms
+cancel for most triads, leaving degree 3: at most six modes): with ``z = e^{i t}`` and f's degree
+m, ``z^m f`` is a polynomial of degree 2m whose roots on the unit circle are the assembly modes.
+Its coefficients are the discrete Fourier transform of ``f`` at 16 angles (exact up to degree 7);
+its roots are the eigenvalues of the companion matrix, for all positions at once.
 """
 
 from __future__ import annotations
@@ -133,25 +133,29 @@ def _closure(A, d, p, t):
 
 
 def _real_roots(f, N: int) -> np.ndarray:
-    """Roots in (-pi, pi] ``(N, 8)`` (NaN-padded) of the degree-4 trigonometric polynomials
-    ``f(t)`` ``(N, K) -> (N, K)``: Fourier coefficients from 16 samples, companion eigenvalues."""
+    """Roots in (-pi, pi] ``(N, 8)`` (NaN-padded) of the trigonometric polynomials ``f(t)``
+    ``(N, K) -> (N, K)`` of degree at most 4: Fourier coefficients from 16 samples, then the
+    eigenvalues of the companion matrix of ``z^m f`` for the degree m each position has (the
+    triad's degree-4 terms cancel for most geometries, leaving degree 3: six roots)."""
     samples = 2 * np.pi * np.arange(16) / 16
     values = f(np.broadcast_to(samples, (N, 16)))
     c = np.fft.fft(values, axis=1) / 16                      # c[k] = coefficient of e^{ikt}; c[-k] at 16 - k
-    coefficients = np.stack([c[:, (k % 16)] for k in range(4, -5, -1)], axis=1)   # z^8 ... z^0
-    scale = np.max(np.abs(coefficients), axis=1)
-    leading = coefficients[:, 0]
-    regular = np.abs(leading) > 1e-12 * np.where(scale > 0, scale, 1.0)
+    scale = np.max(np.abs(c), axis=1)
+    tiny = 1e-11 * np.where(scale > 0, scale, 1.0)
+    degree = np.zeros(N, int)
+    for m in (1, 2, 3, 4):
+        degree = np.where(np.abs(c[:, m]) > tiny, m, degree)
     roots = np.full((N, 8), np.nan + 0j)
-    if regular.any():
-        monic = coefficients[regular, 1:] / leading[regular, None]
-        companion = np.zeros((int(regular.sum()), 8, 8), complex)
+    for m in (1, 2, 3, 4):
+        rows = np.flatnonzero(degree == m)
+        if not len(rows):
+            continue
+        coefficients = np.stack([c[rows, k % 16] for k in range(m, -m - 1, -1)], axis=1)   # z^2m ... z^0
+        monic = coefficients[:, 1:] / coefficients[:, :1]
+        companion = np.zeros((len(rows), 2 * m, 2 * m), complex)
         companion[:, 0, :] = -monic
-        companion[:, np.arange(1, 8), np.arange(7)] = 1.0
-        roots[regular] = np.linalg.eigvals(companion)
-    for n in np.flatnonzero(~regular & (scale > 0)):      # a degenerate leading term: trim it
-        found = np.roots(np.trim_zeros(np.where(np.abs(coefficients[n]) > 1e-12 * scale[n], coefficients[n], 0), "f"))
-        roots[n, :len(found)] = found
+        companion[:, np.arange(1, 2 * m), np.arange(2 * m - 1)] = 1.0
+        roots[rows, :2 * m] = np.linalg.eigvals(companion)
     on_circle = np.abs(np.abs(roots) - 1.0) <= UNIT_CIRCLE_TOL
     return np.where(on_circle, np.angle(roots), np.nan)
 
