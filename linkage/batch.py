@@ -253,28 +253,36 @@ def _geometry(mech: Mechanism, geometry: Geometry) -> dict[str, dict[str, np.nda
     if not isinstance(geometry, Mapping) or not geometry:
         raise InputError("geometry must map link names to {point: array (V, 2)} (at least one point)")
     given: dict[tuple[str, str], np.ndarray] = {}
-    for link, points in geometry.items():
-        if link not in mech.links:
-            raise InputError(f"geometry: mechanism '{mech.name}' has no link {link!r} (links {sorted(mech.links)})")
-        if not isinstance(points, Mapping):
-            raise InputError(f"geometry['{link}'] must map point names to arrays (V, 2), got {type(points).__name__}")
-        for point, values in points.items():
-            if point not in mech.links[link].points:
-                raise InputError(f"geometry['{link}']: link '{link}' has no point {point!r} "
-                                 f"(points {sorted(mech.links[link].points)})")
-            arr = np.asarray(values, dtype=float)
-            if arr.ndim != 2 or arr.shape[1] != 2 or not len(arr):
-                raise InputError(f"geometry['{link}']['{point}'] must have shape (V, 2), got {arr.shape}")
-            if not np.all(np.isfinite(arr)):
-                row = int(np.flatnonzero(~np.all(np.isfinite(arr), axis=1))[0])
-                raise InputError(f"geometry['{link}']['{point}'] of variant {row} is not finite: {arr[row].tolist()}")
-            given[link, point] = arr
+    for link, point, values in link_points(mech, geometry, "geometry", "arrays (V, 2)"):
+        arr = np.asarray(values, dtype=float)
+        if arr.ndim != 2 or arr.shape[1] != 2 or not len(arr):
+            raise InputError(f"geometry['{link}']['{point}'] must have shape (V, 2), got {arr.shape}")
+        if not np.all(np.isfinite(arr)):
+            row = int(np.flatnonzero(~np.all(np.isfinite(arr), axis=1))[0])
+            raise InputError(f"geometry['{link}']['{point}'] of variant {row} is not finite: {arr[row].tolist()}")
+        given[link, point] = arr
     counts = {len(v) for v in given.values()}
     if len(counts) != 1:
         raise InputError(f"geometry: every array needs the same number of variants V, got {sorted(counts)}")
     (count,) = counts
     return {k: {p: given.get((k, p), np.tile(np.asarray(xy_, float), (count, 1))) for p, xy_ in link.points.items()}
             for k, link in mech.links.items()}
+
+
+def link_points(mech: Mechanism, entries: Mapping, what: str, values: str):
+    """``(link, point, value)`` of a mapping ``{link: {point: value}}``, every link and point
+    checked against ``mech`` (``InputError`` naming the entry ``what``; ``values`` says what a
+    value is)."""
+    for link, points in entries.items():
+        if link not in mech.links:
+            raise InputError(f"{what}: mechanism '{mech.name}' has no link {link!r} (links {sorted(mech.links)})")
+        if not isinstance(points, Mapping):
+            raise InputError(f"{what}['{link}'] must map point names to {values}, got {type(points).__name__}")
+        for point, value in points.items():
+            if point not in mech.links[link].points:
+                raise InputError(f"{what}['{link}']: link '{link}' has no point {point!r} "
+                                 f"(points {sorted(mech.links[link].points)})")
+            yield link, point, value
 
 
 def _sizes(mech: Mechanism, local: dict) -> np.ndarray:

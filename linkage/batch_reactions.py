@@ -24,7 +24,7 @@ from numpy.typing import ArrayLike
 
 from assur.base import point_analogs
 
-from .batch import VariantMotion, _per_position
+from .batch import VariantMotion, _per_position, link_points
 from .errors import InputError
 from .forces import LoadTerm, loads_of
 from .kinetostatics import Reactions, reactions_under, virtual_power_residual
@@ -165,16 +165,10 @@ def variant_reactions(
             acc = d2 * (w**2)[:, None] + d1 * e[:, None]
             eps_k = motion.second[k][:, 2] * w**2 + motion.first[k][:, 2] * e
             terms.append(LoadTerm(k, center, -m[:, None] * acc, -J * eps_k, "inertia", f"Fi{k}"))
-    for k, points in (forces or {}).items():
-        if not isinstance(points, Mapping):
-            raise InputError(f"forces['{k}'] must map point names to forces, got {type(points).__name__}")
-        for point, value in points.items():
-            if point not in mech.links[k].points:
-                raise InputError(f"forces['{k}']: link '{k}' has no point {point!r} "
-                                 f"(points {sorted(mech.links[k].points)})")
-            local = _per_position(variants.geometry[k][point], n)
-            force = values(value, f"forces['{k}']['{point}']", (2,))
-            terms.append(LoadTerm(k, local, force, np.zeros(len(force)), "external", f"F{point}"))
+    for k, point, value in link_points(mech, forces or {}, "forces", "forces (Fx, Fy)"):
+        local = _per_position(variants.geometry[k][point], n)
+        force = values(value, f"forces['{k}']['{point}']", (2,))
+        terms.append(LoadTerm(k, local, force, np.zeros(len(force)), "external", f"F{point}"))
     for k, value in (moments or {}).items():
         moment = values(value, f"moments['{k}']")
         terms.append(LoadTerm(k, (0.0, 0.0), np.zeros((len(moment), 2)), moment, "external", f"M{k}"))
