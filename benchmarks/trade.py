@@ -46,6 +46,7 @@ if str(ROOT) not in sys.path:  # run as a script from a checkout
 
 import linkage
 from assur import Group
+from assur.dyad import Dyad
 from linkage.dynamics import course_method, dynamics_of, exact_method, steady_state
 from linkage.errors import AssemblyError, LinkageError, SchemeError
 from linkage.kinematics import BranchWarning
@@ -928,7 +929,8 @@ def newton_schemes() -> dict[str, tuple[str, int]]:
         groups = linkage.structure_of(mech).groups
         has_dynamics = "dynamics" in mech.extra and mech.extra.get("dynamics") is not None
         for i, g in enumerate(groups):
-            candidates.append((g.kind, has_dynamics, len(groups), name, i))
+            if isinstance(g, Dyad):
+                candidates.append((g.kind, has_dynamics, len(groups), name, i))
     out: dict[str, tuple[str, int]] = {}
     for kind, _, _, name, i in sorted(candidates):
         out.setdefault(kind, (name, i))
