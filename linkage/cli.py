@@ -757,11 +757,98 @@ def _cmd_variants(args: argparse.Namespace) -> int:
 
 
 # ----------------------------------------------------------------------------------------------
+# linkage enumerate
+# ----------------------------------------------------------------------------------------------
+
+
+def _add_enumerate(sub) -> None:
+    from .enumeration import CRANK_FACTORS, DEFAULT_OMEGA, MIN_CONDITIONING
+
+    p = sub.add_parser(
+        "enumerate", help="every R/P assignment of a scheme's pairs, each as a scheme that runs a full turn",
+        description="Enumerate the pair kinds of a scheme's chain (docs/enumerate.md): every assignment of "
+                    "R or P (with the guide on either link) to its pairs but the input's, kept when it "
+                    "decomposes into groups with a closed-form solver (RRR, RRP, RPR, PRP, RPP), the "
+                    "others listed with the reason (--rejected). Each kept combination gets the scheme's "
+                    "own geometry; where it does not run a full turn (assembled, regular, conditioning at "
+                    f"least {MIN_CONDITIONING:g}, no change point), a shorter crank "
+                    f"({', '.join(f'{f:g}' for f in CRANK_FACTORS[1:])} of the scheme's) and three "
+                    "further reference positions are tried. Columns: id (e.g. A=R,B=P3,C=R: B "
+                    "prismatic with its guide on link 3), formula, full_turn, crank_factor, "
+                    "reference_deg (deg), output, stroke (m, or deg for a link's swing), stroke_unit, "
+                    "min_transmission_angle_deg (deg), peak_balancing_moment (N m, the largest |M_b| "
+                    "over a turn at --omega under gravity and inertia), note. --out DIR writes "
+                    "DIR/<id>.toml for every combination that runs a full turn (loadable by 'linkage "
+                    "analyze DIR/<id>.toml'), DIR/combinations.csv and DIR/rejected.csv.")
+    _add_scheme_argument(p)
+    p.add_argument("--out", "-o", metavar="DIR", default=None,
+                   help="write the schemes and the tables into DIR (created)")
+    p.add_argument("--omega", metavar="RAD_S", type=_real, default=DEFAULT_OMEGA,
+                   help=f"input speed of the balancing moment, rad/s, signed (default {DEFAULT_OMEGA:g})")
+    p.add_argument("--rejected", action="store_true",
+                   help="list the rejected assignments and why, instead of the table")
+    _add_format_argument(p)
+    p.set_defaults(handler=_cmd_enumerate)
+
+
+def _cmd_enumerate(args: argparse.Namespace) -> int:
+    from .enumeration import COLUMN_UNITS, enumerate_chain
+
+    def progress(iterable, total=None):
+        try:
+            from tqdm import tqdm
+        except ImportError:  # the bar is a nicety of the report extra
+            return iterable
+        return tqdm(iterable, total=total, desc=f"{PROG}: combinations", unit="combination", file=sys.stderr,
+                    disable=None, leave=False, delay=1.0)
+
+    if args.omega == 0.0:
+        raise InputError("--omega 0: the balancing moment needs a nonzero speed, rad/s")
+    found = enumerate_chain(load(args.scheme), omega=args.omega, progress=progress)
+    if args.out is not None:
+        found.write(args.out)
+    running = sum(c.full_turn for c in found.combinations)
+    meta = {"scheme": found.source, "omega": args.omega,
+            "assignments": len(found.combinations) + len(found.rejected), "solvable": len(found.combinations),
+            "full_turn": running, "rejected": len(found.rejected)}
+    if args.rejected:
+        columns, units = found.rejected_columns(), {}
+    else:
+        columns, units = found.columns(), COLUMN_UNITS
+    if args.format == "json":
+        meta["rejected_list"] = [{"id": r.id, "reason": r.reason} for r in found.rejected]
+        meta["references_deg"] = list(found.references_deg)
+    if not len(columns["id"]):
+        _note("note", f"scheme '{found.source}': no {'rejected' if args.rejected else 'solvable'} assignment")
+    if args.format == "table":
+        notes = columns.pop("note", None)
+        meta = {"scheme": found.source,
+                "assignments": f"{meta['assignments']}: {meta['solvable']} decompose into closed-form groups "
+                               f"({running} run a full turn), {meta['rejected']} rejected (see --rejected)",
+                "balancing moment": f"peak |M_b| over a turn at omega = {args.omega:g} rad/s, gravity and "
+                                    "inertia of the scheme's masses"}
+        if args.rejected:  # one line each: the reasons are too long for a column
+            text = "".join(f"# {k}: {v}\n" for k, v in meta.items())
+            text += "".join(f"{i}: {reason}\n" for i, reason in zip(columns["id"], columns["reason"]))
+        else:
+            text = format_columns(columns, "table", meta=meta, units=units) if len(columns["id"]) else ""
+            text += "".join(f"# {i}: {n}\n" for i, n in zip(columns["id"], notes) if n)
+        _out(text or f"# scheme: {found.source}")
+    else:
+        _out(format_columns(columns, args.format, meta=meta if args.format == "json" else None, units=units)
+             if len(columns["id"]) else ",".join(columns))
+    if args.out is not None:
+        _note("note", f"{Path(args.out)}: {running} schemes, combinations.csv, rejected.csv")
+    return 0
+
+
+# ----------------------------------------------------------------------------------------------
 # the parser and main
 # ----------------------------------------------------------------------------------------------
 
 #: functions that register one subcommand each, in the order ``--help`` lists them
-COMMANDS: list[Callable] = [_add_schemes, _add_analyze, _add_forces, _add_dynamics, _add_report, _add_variants]
+COMMANDS: list[Callable] = [_add_schemes, _add_analyze, _add_forces, _add_dynamics, _add_report, _add_variants,
+                            _add_enumerate]
 
 
 def build_parser() -> argparse.ArgumentParser:
