@@ -10,14 +10,15 @@ from .errors import AssemblyError, InputError, LinkageError, SchemeError, Struct
 from .extremes import extreme_positions, table_angles
 from .kinematics import Motion, analyze, structure_of
 from .batch import VariantMotion, analyze_variants, geometry_of
+from .input_laws import InputLaw
 from .model import Mechanism, MechanismBuilder
 from .scheme import dumps, load, loads, save, shipped_schemes
 from .structure import decompose, mobility
 from . import forces, dynamics  # noqa: F401  (register the [loads] and [dynamics] sections)
 
 __all__ = [
-    "AssemblyError", "InputError", "LinkageError", "SchemeError", "StructureError", "Mechanism",
-    "MechanismBuilder", "Motion", "VariantMotion", "analyze", "analyze_variants", "decompose",
+    "AssemblyError", "InputError", "LinkageError", "SchemeError", "StructureError", "InputLaw",
+    "Mechanism", "MechanismBuilder", "Motion", "VariantMotion", "analyze", "analyze_variants", "decompose",
     "geometry_of", "dumps", "extreme_positions", "load",
     "loads", "mobility", "save", "shipped_schemes", "structure_of", "table_angles",
 ]

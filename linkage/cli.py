@@ -232,6 +232,61 @@ def _real(text: str) -> float:
 def _add_scheme_argument(p: argparse.ArgumentParser) -> None:
     p.add_argument("scheme", metavar="SCHEME",
                    help="a shipped scheme name (see 'linkage schemes') or the path of a .toml file")
+    p.add_argument("--input-law", metavar="LINK:LAW", action="append", type=_input_law, default=[],
+                   help="for a scheme with several input links: how the further input LINK turns with the "
+                        "first input's angle phi, replacing the scheme's law; LAW is RATIO or RATIO:PHASE_DEG "
+                        "(theta = RATIO * phi + PHASE), or the path of a CSV file of rows phi_deg,theta_deg "
+                        "(docs/inputs.md); repeat it per link")
+
+
+def _input_law(text: str):
+    """``LINK:RATIO[:PHASE_DEG]`` or ``LINK:FILE.csv`` -> ``(link, InputLaw)``."""
+    from .input_laws import InputLaw, table_problems
+
+    link, sep, law = text.partition(":")
+    if not (link and sep and law):
+        raise argparse.ArgumentTypeError(f"expected LINK:RATIO[:PHASE_DEG] or LINK:FILE.csv, got {text!r}")
+    if law.lower().endswith(".csv"):
+        table = _law_table(link, law)
+        problems = table_problems(f"input law of link '{link}' ({law})", table)
+        if problems:
+            raise argparse.ArgumentTypeError("; ".join(problems))
+        return link, InputLaw(table=table)
+    ratio, _, phase = law.partition(":")
+    values = [_real(ratio), _real(phase) if phase else 0.0]
+    if values[0] == 0:
+        raise argparse.ArgumentTypeError(f"input law of link '{link}': the ratio must be nonzero, got {ratio!r}")
+    return link, InputLaw(values[0], math.radians(values[1]))
+
+
+def _law_table(link: str, path: str) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """The rows ``phi_deg,theta_deg`` of a CSV file (a header line allowed, ``#`` comments) in rad."""
+    where = f"input law of link '{link}': {path}"
+    try:
+        lines = Path(path).read_text(encoding="utf-8").splitlines()
+    except (OSError, UnicodeDecodeError) as exc:
+        raise argparse.ArgumentTypeError(f"{where}: cannot read it ({exc})") from None
+    rows = []
+    for number, line in enumerate(lines, 1):
+        cells = [c.strip() for c in line.split("#")[0].split(",")]
+        if cells == [""]:
+            continue
+        try:
+            if len(cells) != 2:
+                raise ValueError
+            rows.append([math.radians(float(c)) for c in cells])
+        except ValueError:
+            if rows or number > 1:    # only the first line may be a header
+                raise argparse.ArgumentTypeError(f"{where}, line {number}: expected two numbers phi_deg,theta_deg, "
+                                                 f"got {line.strip()!r}") from None
+    return tuple(r[0] for r in rows), tuple(r[1] for r in rows)
+
+
+def _load_scheme(args: argparse.Namespace):
+    """The scheme named on the command line, with the input laws given by ``--input-law``."""
+    mech = load(args.scheme)
+    laws = dict(getattr(args, "input_law", []) or [])
+    return mech.with_input_laws(**laws) if laws else mech
 
 
 class _RangeAction(argparse.Action):
@@ -372,6 +427,7 @@ def _analyze_view(mech):
     def view(columns: dict) -> list[str]:
         triple = lambda q: [q, q + "'", q + "''"]  # noqa: E731
         groups = [[f"{link}.theta" for link in mech.inputs]]
+        groups += [[f"{link}.theta'", f"{link}.theta''"] for link in mech.inputs[1:]]
         if mech.output is not None:
             groups.append(triple(mech.output.quantity))
         groups += [triple(f"{link}.theta") for link in mech.moving_links if link not in mech.inputs]
@@ -405,7 +461,7 @@ def _start_line(mech, phi: np.ndarray, start, n: int, direction: int | None = No
 
 
 def _cmd_analyze(args: argparse.Namespace) -> int:
-    mech = load(args.scheme)
+    mech = _load_scheme(args)
     results = kinematics_results(mech, args.positions, args.start)
     _say(results)
     meta = results.meta
@@ -450,7 +506,8 @@ def _add_forces(sub) -> None:
         description="Reactions in every pair and the balancing moment on the input link at N "
                     "equal steps of phi, from the scheme's loads (gravity, external forces and "
                     "diagrams) and the inertia loads of the given motion (docs/methods.md). "
-                    "Columns: i, phi_deg, balancing_moment (N m, CCW positive), and for each pair "
+                    "Columns: i, phi_deg, balancing_moment (N m, CCW positive; with several input "
+                    "links the first's, and balancing_moment.L for each further input link L), and for each pair "
                     "K: K.R (N) and K.angle_deg, the magnitude and direction of the force R[a, b] "
                     "that link b exerts on link a for the pair's links = [a, b]; K.Rx, K.Ry (N) "
                     "and, for prismatic pairs, K.M (N m, about the slider's point). The table for "
@@ -471,13 +528,14 @@ def _forces_view(columns: dict) -> list[str]:
     """The default columns of ``linkage forces`` for people: the balancing moment, then the
     magnitude of every reaction, then their directions, as many as fit, in table order."""
     pairs = [name[:-2] for name in columns if name.endswith(".R")]
-    groups = [["balancing_moment"]] + [[f"{k}.R"] for k in pairs] + [[f"{k}.angle_deg"] for k in pairs]
+    moments = [name for name in columns if name.startswith("balancing_moment")]
+    groups = [moments] + [[f"{k}.R"] for k in pairs] + [[f"{k}.angle_deg"] for k in pairs]
     shown = set(_fit(columns, ("i", "phi_deg"), groups))
     return [name for name in columns if name in shown]
 
 
 def _cmd_forces(args: argparse.Namespace) -> int:
-    mech = load(args.scheme)
+    mech = _load_scheme(args)
     results = forces_results(mech, args.positions, args.start, _speed(args), args.eps)
     _say(results)
     meta = results.meta
@@ -552,7 +610,7 @@ def _cmd_dynamics(args: argparse.Namespace) -> int:
     from .dynamics import _override, simulate
     from .report.results import dynamics_results
 
-    mech = load(args.scheme)
+    mech = _load_scheme(args)
     if args.transient and args.method != "ode":
         raise InputError(f"--transient: the start-up is a solution of the equation of motion with the "
                          f"motor: give --method ode with it (got --method {args.method})")
@@ -679,7 +737,7 @@ def _cmd_report(args: argparse.Namespace) -> int:
     from .report.folder import require_report_extra, write_report
 
     require_report_extra()
-    mech = load(args.scheme)
+    mech = _load_scheme(args)
     report = write_report(mech, args.out, progress=_progress("report"))
     for line in report.notes:
         _note("note", line)
@@ -804,7 +862,7 @@ def _cmd_enumerate(args: argparse.Namespace) -> int:
 
     if args.omega == 0.0:
         raise InputError("--omega 0: the balancing moment needs a nonzero speed, rad/s")
-    found = enumerate_chain(load(args.scheme), omega=args.omega, progress=progress)
+    found = enumerate_chain(_load_scheme(args), omega=args.omega, progress=progress)
     if args.out is not None:
         found.write(args.out)
     running = sum(c.full_turn for c in found.combinations)

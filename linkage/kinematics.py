@@ -25,7 +25,7 @@ from assur.base import ANALOG_TOL, CANNOT_ASSEMBLE, OK, SINGULAR, global_point, 
 from assur.rows import frame, xy
 
 from .assembly import assembly_branches, assembly_plans, place_group
-from .errors import AssemblyError, InputError, StructureError
+from .errors import AssemblyError, InputError
 from .model import Mechanism, Prismatic
 from .structure import Structure, decompose
 
@@ -308,7 +308,9 @@ def analyze(
     Parameters
     ----------
     mech : Mechanism
-        The mechanism (one input link).
+        The mechanism. With several input links, ``phi`` is the first one's angle and the others
+        follow their laws (:class:`~linkage.input_laws.InputLaw`); analogs are derivatives with
+        respect to ``phi``.
     phi : array_like, shape (N,) or scalar
         Input angles, rad (CCW from +x, docs/conventions.md).
     order : {0, 1, 2}
@@ -332,13 +334,10 @@ def analyze(
     if on_failure not in ("raise", "mask"):
         raise InputError(f"on_failure must be 'raise' or 'mask', got {on_failure!r}")
     structure = structure_of(mech)
-    if len(structure.inputs) != 1:
-        raise StructureError(
-            f"mechanism '{mech.name}' has {len(structure.inputs)} inputs; analysis over one input "
-            "angle needs exactly one input link")
     phi = np.atleast_1d(np.asarray(phi, dtype=float))
     if phi.ndim != 1 or not np.all(np.isfinite(phi)):
         raise InputError("phi must be a finite scalar or 1-D array of angles in rad")
+    _check_law_domains(mech, phi)
     plans = assembly_plans(mech)
     group_ids = range(len(structure.groups)) if outputs is None else \
         structure.needed_groups(_links_of(mech, outputs))
@@ -360,6 +359,19 @@ def analyze(
     return Motion(mech, structure, phi, poses, first if order >= 1 else None,
                   second if order >= 2 else None, status, omega_arr, eps_arr, run.conditioning,
                   run.error_bound)
+
+
+def _check_law_domains(mech: Mechanism, phi: np.ndarray) -> None:
+    """Refuse input angles outside the table of a further input's law that holds over less than a turn."""
+    for link, law in mech.input_laws.items():
+        if law.domain is None:
+            continue
+        low, high = law.domain
+        outside = (phi < low - 1e-9) | (phi > high + 1e-9)
+        if outside.any():
+            shown = ", ".join(f"{v:.6g}" for v in np.degrees(phi[outside][:5]))
+            raise InputError(f"mechanism '{mech.name}': input angle(s) {shown} deg lie outside the table of "
+                             f"input link '{link}' ({np.degrees(low):.6g} to {np.degrees(high):.6g} deg)")
 
 
 def input_sweep(mech: Mechanism) -> Motion:
@@ -475,9 +487,9 @@ def _largest(values: list) -> np.ndarray | float:
 
 def _input_state(mech: Mechanism, structure: Structure, phi: np.ndarray, poses: dict, first: dict | None = None,
                  second: dict | None = None) -> dict:
-    """Write the poses and analogs of the input link at the angles ``phi`` into the ``(N, 3)``
-    arrays of ``poses`` / ``first`` / ``second`` (the frame's are zeros; arrays are allocated
-    when missing). Returns the frames ``(x, y, c, s, theta)`` of the frame and the input link."""
+    """Write the poses and analogs of the input links at the first input's angles ``phi`` into the
+    ``(N, 3)`` arrays of ``poses`` / ``first`` / ``second`` (the frame's are zeros; arrays are
+    allocated when missing). Returns the frames ``(x, y, c, s, theta)`` of the frame and the inputs."""
     N = len(phi)
     for d in (poses, first, second):
         if d is not None:
@@ -488,20 +500,34 @@ def _input_state(mech: Mechanism, structure: Structure, phi: np.ndarray, poses: 
                     d[link] = np.empty((N, 3))
     zeros = np.zeros(N)
     frames = {mech.frame: (zeros, zeros, np.ones(N), zeros, zeros)}
-    c, s = np.cos(phi), np.sin(phi)
-    for name in structure.inputs:
+    for name, (theta, rate, accel) in input_angles(mech, structure, phi).items():
         joint = structure.input_joints[name]
         p_input, _, p_frame = joint.local(name)
         (px, py), (fx, fy) = xy(p_input), xy(p_frame)
+        c, s = np.cos(theta), np.sin(theta)
         rx, ry = c * px - s * py, s * px + c * py
         out = poses[name]
-        out[:, 0], out[:, 1], out[:, 2] = fx - rx, fy - ry, phi
+        out[:, 0], out[:, 1], out[:, 2] = fx - rx, fy - ry, theta
         frames[name] = (out[:, 0], out[:, 1], c, s, out[:, 2])
         if first is not None:
-            first[name][:, 0], first[name][:, 1], first[name][:, 2] = ry, -rx, 1.0
+            first[name][:, 0], first[name][:, 1], first[name][:, 2] = ry * rate, -rx * rate, rate
         if second is not None:
-            second[name][:, 0], second[name][:, 1], second[name][:, 2] = rx, ry, 0.0
+            # d2/dphi2 of fx - R(theta) p: rate^2 (R p) - accel (R p turned by 90 deg)
+            second[name][:, 0] = rx * rate**2 + ry * accel
+            second[name][:, 1] = ry * rate**2 - rx * accel
+            second[name][:, 2] = accel
     return frames
+
+
+def input_angles(mech: Mechanism, structure: Structure, phi: np.ndarray) -> dict[str, tuple]:
+    """Each input link's angle and its first and second analogs ``(theta, dtheta/dphi,
+    d2theta/dphi2)``, ``(N,)`` each, at the first input's angles ``phi`` (the first input: ``phi``,
+    1, 0; further inputs: their :class:`~linkage.input_laws.InputLaw`)."""
+    ones, zeros = np.ones(len(phi)), np.zeros(len(phi))
+    out = {}
+    for k, name in enumerate(structure.inputs):
+        out[name] = (phi, ones, zeros) if k == 0 else mech.input_laws[name].angles(phi)
+    return out
 
 
 def input_poses(mech: Mechanism, structure: Structure, phi: np.ndarray) -> dict[str, np.ndarray]:

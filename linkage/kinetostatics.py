@@ -21,7 +21,7 @@ True
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from typing import Iterable
 
@@ -49,10 +49,15 @@ class Reactions:
         The group solvers' Lagrange multipliers (see :class:`assur.base.RevoluteJoint` and
         :class:`assur.base.PrismaticJoint`).
     balancing_moment : ndarray (N,)
-        ``M_b``, the moment to apply to the input link for the given motion, N m (CCW positive).
+        ``M_b``, the moment to apply to the (first) input link for the given motion, N m (CCW
+        positive).
     terms : list of LoadTerm
         The applied and inertia loads used.
     notes : tuple of str
+    balancing_moments : dict of input link -> ndarray (N,)
+        The balancing moment of every input link, N m (CCW positive): with several inputs
+        (:class:`~linkage.input_laws.InputLaw`), each motor's share; the first is
+        ``balancing_moment``.
     """
 
     motion: Motion
@@ -60,6 +65,7 @@ class Reactions:
     balancing_moment: np.ndarray
     terms: list[LoadTerm]
     notes: tuple[str, ...] = ()
+    balancing_moments: dict[str, np.ndarray] = field(default_factory=dict)
 
     def force(self, pair: str) -> np.ndarray:
         """``R[a, b]`` ``(N, 2)`` for the pair declared with ``links = [a, b]``, N."""
@@ -96,8 +102,8 @@ class Reactions:
         return np.degrees(angle_in_half_turn(np.arctan2(f[:, 1], f[:, 0])))
 
     def columns(self, full: bool = False, direction: int | None = None) -> dict[str, np.ndarray]:
-        """Table: ``i``, ``phi_deg`` (as in :meth:`Motion.columns`), ``balancing_moment`` (N m),
-        per pair ``K.R`` (magnitude of ``R[a, b]``, N) and ``K.angle_deg`` (its direction, deg CCW
+        """Table: ``i``, ``phi_deg`` (as in :meth:`Motion.columns`), ``balancing_moment`` (N m; with
+        several inputs, the first's, and ``balancing_moment.K`` for each further input link K), per pair ``K.R`` (magnitude of ``R[a, b]``, N) and ``K.angle_deg`` (its direction, deg CCW
         from +x in (-180, 180]); with ``full`` also ``K.Rx``, ``K.Ry`` (N) and, for
         prismatic pairs, ``K.M`` (N m, the moment of the slider on the guide about the slider's
         point). Pairs in the order of their names. ``direction``: see :meth:`Motion.columns`."""
@@ -105,6 +111,8 @@ class Reactions:
         cols = {"i": np.arange(1, len(self.motion.phi) + 1),
                 "phi_deg": table_positions_deg(self.motion.phi, direction),
                 "balancing_moment": self.balancing_moment}
+        for link in self.motion.structure.inputs[1:]:
+            cols[f"balancing_moment.{link}"] = self.balancing_moments.get(link, np.full(len(self.motion.phi), np.nan))
         for name in sorted(self.multipliers):
             cols[f"{name}.R"] = self.magnitude(name)
             cols[f"{name}.angle_deg"] = self.direction_deg(name)
@@ -206,19 +214,20 @@ def reactions_under(motion: Motion, terms: list[LoadTerm], pairs: Iterable[str] 
         notes = notes + ("balancing moment not computed: only the reactions in pairs "
                          f"{sorted(pairs)} were asked for",)
         return Reactions(motion, multipliers, np.full(len(motion.phi), np.nan), terms, notes)
-    (link,) = structure.inputs
-    joint = structure.input_joints[link]
-    # the input link's equilibrium: its pin carries the force, M_b what is left of the moment
-    pin = rows_of(joint, {k: motion.frame(k) for k in (joint.a, joint.b)})
-    load = -applied[link]
-    force = pin.multipliers(link, (load[:, 0], load[:, 1], load[:, 2]))
-    multipliers[joint.name] = np.column_stack(force)
-    balancing = load[:, 2] - pin.constraint_load(link, force)[2]
+    balancing = {}
+    for link in structure.inputs:
+        # each input link's equilibrium: its pin carries the force, its M_b what is left of the moment
+        joint = structure.input_joints[link]
+        pin = rows_of(joint, {k: motion.frame(k) for k in (joint.a, joint.b)})
+        load = -applied[link]
+        force = pin.multipliers(link, (load[:, 0], load[:, 1], load[:, 2]))
+        multipliers[joint.name] = np.column_stack(force)
+        balancing[link] = load[:, 2] - pin.constraint_load(link, force)[2]
     bad = ~valid
     if bad.any():
-        balancing = np.where(bad, np.nan, balancing)
+        balancing = {k: np.where(bad, np.nan, v) for k, v in balancing.items()}
         multipliers = {k: np.where(bad[:, None], np.nan, v) for k, v in multipliers.items()}
-    return Reactions(motion, multipliers, balancing, terms, notes)
+    return Reactions(motion, multipliers, balancing[structure.inputs[0]], terms, notes, balancing)
 
 
 def virtual_power_residual(reactions: Reactions) -> np.ndarray:
@@ -226,7 +235,7 @@ def virtual_power_residual(reactions: Reactions) -> np.ndarray:
 
     With virtual velocities (the first analogs: a virtual crank rate of 1 rad/s, so the result
     does not depend on the real ``omega`` and stays defined where it is 0) the powers are
-    ``P_b = M_b`` and ``P_t = F . r'_P + M theta_k'`` for every applied and inertia load t.
+    ``P_b = M_b`` (with several inputs, ``sum_k M_b,k theta_k'``) and ``P_t = F . r'_P + M theta_k'`` for every applied and inertia load t.
     Reactions of ideal pairs do no work, so their sum is zero when the reactions are right. The
     residual is::
 
@@ -247,6 +256,8 @@ def virtual_power_residual(reactions: Reactions) -> np.ndarray:
     motion = reactions.motion
     size = motion.mechanism.size
     powers = [reactions.balancing_moment]
+    for link in motion.structure.inputs[1:]:
+        powers.append(reactions.balancing_moments[link] * motion.first[link][:, 2])
     typical = np.zeros(len(motion.phi))
     for t in reactions.terms:
         pose, first = motion.poses[t.link], motion.first[t.link]

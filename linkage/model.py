@@ -31,6 +31,7 @@ from typing import Any, Mapping
 import networkx as nx
 
 from .errors import SchemeError
+from .input_laws import InputLaw, table_problems
 
 __all__ = [
     "Guide",
@@ -195,6 +196,9 @@ class Mechanism:
     mechanism is analysed (a mechanism whose input does not turn fully: a rocker input, a
     tangent mechanism): tables run from ``a`` to ``b``, extreme positions are searched within
     it, and computations over a full turn (cycle dynamics) refuse it. None: a full turn.
+
+    ``input_laws`` maps each input link after the first to the law its angle follows as a function
+    of the first input's angle ``phi`` (:class:`~linkage.input_laws.InputLaw`; mobility W > 1).
     """
 
     name: str
@@ -207,6 +211,7 @@ class Mechanism:
     description: str = ""
     extra: Mapping[str, Any] = field(default_factory=dict, compare=True)
     input_range: tuple[float, float] | None = None
+    input_laws: Mapping[str, InputLaw] = field(default_factory=dict)
 
     @cached_property
     def parts(self) -> dict[str, Any]:
@@ -277,8 +282,20 @@ class Mechanism:
         merged.update(extra)
         return Mechanism(
             self.name, self.links, self.pairs, self.inputs, self.frame, self.assembly,
-            self.output, self.description, merged, self.input_range,
+            self.output, self.description, merged, self.input_range, self.input_laws,
         )
+
+    def with_input_laws(self, **laws: InputLaw) -> "Mechanism":
+        """A copy whose further input links follow the given laws (the others keep theirs),
+        validated; its further sections (loads, dynamics) are parsed again on first use, since
+        their stroke ends depend on the motion. Raises :class:`SchemeError` naming the problems."""
+        copy = Mechanism(self.name, self.links, self.pairs, self.inputs, self.frame, self.assembly,
+                         self.output, self.description, dict(self.extra), self.input_range,
+                         {**self.input_laws, **laws})
+        problems = [f"mechanism '{self.name}': {p}" for p in _law_problems(copy)]
+        if problems:
+            raise SchemeError(problems)
+        return copy
 
 
 # ----------------------------------------------------------------------------------------------
@@ -431,6 +448,7 @@ class MechanismBuilder:
         self._links: dict[str, Link] = {}
         self._pairs: dict[str, Revolute | Prismatic] = {}
         self._inputs: list[str] = []
+        self._laws: dict[str, InputLaw] = {}
         self._assembly: list[Assembly] = []
         self._output: Output | None = None
         self._range: tuple[float, float] | None = None
@@ -617,8 +635,33 @@ class MechanismBuilder:
 
     # -- the rest ------------------------------------------------------------------------------
     def inputs(self, *links: str) -> "MechanismBuilder":
-        """Declare the input links (cranks), each pinned to the frame; its angle is ``phi``."""
+        """Declare the input links (cranks), each pinned to the frame. The first one's angle is
+        ``phi``; each further one turns by its :meth:`input_law`."""
         self._inputs.extend(links)
+        return self
+
+    def input_law(self, link: str, *, ratio: float | None = None, phase: float | None = None,
+                  table=None) -> "MechanismBuilder":
+        """The angle of the further input ``link`` as a function of the first input's ``phi``:
+        ``ratio * phi + phase`` (rad; defaults 1 and 0), or ``table=(phi, theta)``, two sequences of
+        angles (rad) interpolated by a cubic spline (see :class:`~linkage.input_laws.InputLaw`)."""
+        where = f"input law of link '{link}'"
+        if link in self._laws:
+            self._problems.append(f"{where}: declared twice")
+            return self
+        if table is not None:
+            found = table_problems(where, table) + ([f"{where}: give either a table or a ratio and a phase, not both"]
+                                                    if ratio is not None or phase is not None else [])
+            self._problems.extend(found)
+            if not found:
+                self._laws[link] = InputLaw(table=tuple(tuple(float(v) for v in column) for column in table))
+            return self
+        found: list[str] = []
+        ratio = 1.0 if ratio is None else check_number(ratio, where, "ratio", found, "nonzero")
+        phase = 0.0 if phase is None else check_number(phase, where, "phase", found, "angle", "rad")
+        self._problems.extend(found)
+        if not found:
+            self._laws[link] = InputLaw(ratio, phase)
         return self
 
     def assembly(
@@ -717,6 +760,7 @@ class MechanismBuilder:
             self.description,
             dict(extra),
             self._range,
+            dict(self._laws),
         )
         refused = dict(self._unplaced)
         for name in self._incomplete:
@@ -804,6 +848,7 @@ def validate(mech: Mechanism, rejected=frozenset(), unplaced: Mapping[str, set] 
         elif not rejected and not any(isinstance(pr, Revolute) and set(pr.links) == {name, mech.frame}
                                       for pr in mech.pairs.values()):
             p.append(f"input link '{name}' is not pinned to the frame '{mech.frame}' by a revolute pair")
+    p.extend(_law_problems(mech))
     known_points = {q for lk in links.values() for q in lk.points}
     refused_points = {q for names in unplaced.values() for q in names}
     for rule in mech.assembly:
@@ -813,6 +858,35 @@ def validate(mech: Mechanism, rejected=frozenset(), unplaced: Mapping[str, set] 
     if mech.output is not None:
         p.extend(_output_problems(mech, refused=set(rejected) | refused_points))
     return p
+
+
+def _law_problems(mech: Mechanism) -> list[str]:
+    """Problems of the input laws: one per further input, none for the first or a link that is no
+    input; a table over less than a turn needs an input range inside it."""
+    problems = []
+    first, further = (mech.inputs[0], mech.inputs[1:]) if mech.inputs else (None, ())
+    for link in mech.input_laws:
+        if link == first:
+            problems.append(f"input law of link '{link}': the first input link's angle is phi itself; "
+                            "laws are for the further input links")
+        elif link not in further:
+            problems.append(f"input law of link '{link}': '{link}' is not an input link (inputs {list(mech.inputs)})")
+    for link in further:
+        if link not in mech.input_laws:
+            problems.append(f"input link '{link}' needs a law (input_laws.{link}: ratio and phase_deg, or table_deg): "
+                            f"how its angle follows the first input's ('{first}')")
+    for link, law in mech.input_laws.items():
+        if law.domain is None or link not in further:
+            continue
+        low, high = law.domain
+        span = mech.input_range
+        inside = span is not None and low - 1e-9 <= min(span) and max(span) <= high + 1e-9
+        if not inside:
+            given = "none" if span is None else f"[{math.degrees(span[0]):.10g}, {math.degrees(span[1]):.10g}] deg"
+            problems.append(f"input law of link '{link}': its table holds for phi in [{math.degrees(low):.10g}, "
+                            f"{math.degrees(high):.10g}] deg only (less than a turn), so the mechanism needs an input "
+                            f"range inside it (range_deg); input range: {given}")
+    return problems
 
 
 def _output_problems(mech: Mechanism, refused=frozenset()) -> list[str]:

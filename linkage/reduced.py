@@ -142,9 +142,9 @@ def reduced_characteristics(
             driving += power
         else:
             resisting += power
-    inputs = set(motion.structure.inputs)
-    others = [k for k in mech.moving_links if k not in inputs]
+    crank = motion.structure.inputs[0]   # further inputs (mobility W > 1) turn by their laws: variable terms
+    others = [k for k in mech.moving_links if k != crank]
     variable, half_derivative = link_inertia_terms(motion, others)
-    own, _ = link_inertia_terms(motion, sorted(inputs))
+    own, _ = link_inertia_terms(motion, [crank])
     return Reduced(motion.phi, rotation, resisting, driving, float(own[0]) + float(extra_inertia),
                    variable, 2 * rotation * half_derivative)

@@ -26,8 +26,8 @@ from .model import (MAX_ANGLE_DEG, Mechanism, MechanismBuilder, Prismatic, Revol
 __all__ = ["load", "loads", "dumps", "save", "shipped_schemes", "scheme_path", "section_of",
            "register_section", "SECTION_PARSERS"]
 
-TOP_KEYS = {"name", "description", "frame", "input", "inputs", "output", "links", "pairs", "assembly",
-            "range", "range_deg"}
+TOP_KEYS = {"name", "description", "frame", "input", "inputs", "input_laws", "output", "links", "pairs",
+            "assembly", "range", "range_deg"}
 LINK_KEYS = {"line", "length", "points", "guides", "mass", "com", "inertia"}
 PAIR_KEYS = {"kind", "links", "at", "guide", "angle", "angle_deg"}
 #: keys of a link that place its points or guides (or its centre of mass, which its mass needs):
@@ -241,6 +241,8 @@ def from_dict(data: Mapping[str, Any], default_name: str = "mechanism") -> Mecha
         problems.append(f"input: expected a link name or a list of names, got {inputs!r}")
         inputs = None
     builder.inputs(*(inputs or []))
+    for link, spec in _table(data, "input_laws", problems).items():
+        _add_input_law(builder, link, spec, problems)
     for point, spec in _table(data, "assembly", problems).items():
         _add_assembly(builder, point, spec, problems)
     output = data.get("output")
@@ -415,6 +417,34 @@ def _add_assembly(builder, point, spec, problems):
                      mode=spec.get("mode", "keep"), phi=phi)
 
 
+def _add_input_law(builder, link, spec, problems):
+    """``[input_laws.K]``: ``ratio`` and ``phase_deg`` (or ``phase``, rad), or ``table_deg`` (or
+    ``table``, rad): pairs ``[phi, theta]`` of the first input's angle and link K's."""
+    where = f"input_laws.{link}"
+    if not isinstance(spec, Mapping):
+        problems.append(f"{where}: expected a table such as {{ratio = -1, phase_deg = 90}}, got {spec!r}")
+        return
+    if unknown_keys(spec, {"ratio", "phase", "phase_deg", "table", "table_deg"}, where, problems):
+        return
+    count = len(problems)
+    phase = _angle(spec, "phase", where, problems, default=None)
+    if "table" in spec and "table_deg" in spec:
+        problems.append(f"{where}: give either 'table' (rad) or 'table_deg' (deg), not both")
+    if len(problems) > count:
+        return
+    raw = spec.get("table_deg", spec.get("table"))
+    table = None
+    if raw is not None:
+        key = "table_deg" if "table_deg" in spec else "table"
+        if not (isinstance(raw, list) and all(isinstance(row, list) and len(row) == 2 and all(map(_is_number, row))
+                                              for row in raw)):
+            problems.append(f"{where}: {key} must be a list of pairs [phi, theta] of numbers, got {raw!r}")
+            return
+        scale = math.pi / 180 if key == "table_deg" else 1.0
+        table = ([row[0] * scale for row in raw], [row[1] * scale for row in raw])
+    builder.input_law(link, ratio=spec.get("ratio"), phase=phase, table=table)
+
+
 # ----------------------------------------------------------------------------------------------
 # writing
 # ----------------------------------------------------------------------------------------------
@@ -431,6 +461,9 @@ def to_dict(mech: Mechanism) -> dict[str, Any]:
         data["output"] = {"quantity": mech.output.quantity, "start": mech.output.start}
     if mech.input_range is not None:
         data["range"] = list(mech.input_range)
+    if mech.input_laws:
+        data["input_laws"] = {link: {"table": [list(row) for row in zip(*law.table)]} if law.table is not None
+                              else {"ratio": law.ratio, "phase": law.phase} for link, law in mech.input_laws.items()}
     data["links"] = {}
     for name in sorted(mech.links):
         link = mech.links[name]

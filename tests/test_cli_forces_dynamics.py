@@ -196,7 +196,8 @@ def test_forces_every_scheme_every_format(capsys, scheme):
     assert "Traceback" not in err_csv + err_table + err_json
 
     cols = read_csv(out_csv)
-    expected = ["i", "phi_deg", "balancing_moment"] + [f"{k}.{c}" for k in pairs for c in ("R", "angle_deg")]
+    expected = ["i", "phi_deg", "balancing_moment"] + [f"balancing_moment.{k}" for k in mech.inputs[1:]]
+    expected += [f"{k}.{c}" for k in pairs for c in ("R", "angle_deg")]
     # CSV and JSON: every column, the components (and K.M for prismatic pairs) too
     extra = [f"{k}.{c}" for k in pairs for c in ("Rx", "Ry")] + [f"{k}.M" for k in prismatic]
     assert sorted(cols) == sorted(expected + extra)

@@ -287,7 +287,7 @@ def _loaded_scheme(name: str):
     force = [-350.0, 120.0]
     shipped = linkage.load(name)
     turning = linkage.analyze(shipped, PHI, order=1).first
-    (crank,) = shipped.inputs
+    crank = shipped.inputs[0]
     rotating = [k for k in moving if k != crank and np.ptp(turning[k][:, 2]) > 1e-6] or [crank]
     moments = [(moving[1], -17.5), (rotating[0], 6.25)]
     data["loads"] = {
@@ -319,6 +319,8 @@ def _power_balance(reactions, mech, extras, omega, eps):
     e = np.broadcast_to(eps, PHI.shape)
     g = np.array([0.0, -G])
     powers = [reactions.balancing_moment * w]
+    for k in mech.inputs[1:]:      # further inputs: their own balancing moments at their own speeds
+        powers.append(reactions.balancing_moments[k] * motion.first[k][:, 2] * w)
     for k in mech.moving_links:
         link = mech.links[k]
         _, v1, a2 = _rigid(motion, k, link.center_of_mass)

@@ -37,6 +37,7 @@ EXPECTED_FORMULAS = {
     "six_bar_class3": "I(0,1) → III(2,3,4,5)",         # legs 2, 4, 5 on the ternary link 3
     "watt_six_bar": "I(0,1) → II-RRR(2,3) → II-RRR(4,5)",
     "stephenson_six_bar": "I(0,1) → II-RRR(2,3) → II-RRR(4,5)",
+    "five_bar_two_input": "I(0,1) → I(0,4) → II-RRR(2,3)",   # two cranks place one dyad
 }
 
 SCHEMES = sorted(linkage.shipped_schemes())

@@ -47,6 +47,7 @@ HAND_MOBILITY = {
     "six_bar_class3": 3 * 5 - 2 * 7,         # links 1..5; pairs O A B C D E F
     "watt_six_bar": 3 * 5 - 2 * 7,           # links 1..5; seven revolute pairs
     "stephenson_six_bar": 3 * 5 - 2 * 7,     # links 1..5; seven revolute pairs
+    "five_bar_two_input": 3 * 4 - 2 * 5,     # links 1..4; pairs O A B D Q
 }
 
 #: structural formulas derived by hand from the scheme files (docs/methods.md#structure)
@@ -65,12 +66,14 @@ HAND_FORMULA = {
     # a crank-rocker (2, 3) first; its plate drives the second dyad (4, 5)
     "watt_six_bar": "I(0,1) → II-RRR(2,3) → II-RRR(4,5)",
     "stephenson_six_bar": "I(0,1) → II-RRR(2,3) → II-RRR(4,5)",
+    # cranks 1 (O, A) and 4 (Q, D) on the frame; couplers 2 (A, B) and 3 (D, B) meet at B
+    "five_bar_two_input": "I(0,1) → I(0,4) → II-RRR(2,3)",
 }
 
 
 @pytest.mark.parametrize("name", sorted(HAND_MOBILITY))
 def test_mobility_by_hand(name):
-    assert HAND_MOBILITY[name] == 1
+    assert HAND_MOBILITY[name] == len(linkage.load(name).inputs)
     assert linkage.mobility(linkage.load(name)) == HAND_MOBILITY[name]
 
 
@@ -126,11 +129,13 @@ def test_five_bar_two_inputs():
     b.link("4", line=("E", "C"), length=0.12)
     for pair, x, y in [("O", "0", "1"), ("A", "1", "2"), ("B", "2", "3"), ("C", "3", "4"), ("E", "4", "0")]:
         b.revolute(pair, x, y)
-    mech = b.inputs("1", "4").assembly("B", left_of=("A", "C")).build()
+    b.inputs("1", "4").assembly("B", left_of=("A", "C"))
+    with pytest.raises(SchemeError, match="input link '4' needs a law"):
+        b.build()        # how the second crank turns with the first must be declared
+    mech = b.input_law("4", ratio=1.0).build()
     assert linkage.mobility(mech) == 3 * 4 - 2 * 5
     assert linkage.decompose(mech).formula == "I(0,1) → I(0,4) → II-RRR(2,3)"
-    with pytest.raises(StructureError, match="five_bar"):
-        linkage.analyze(mech, [0.3])
+    assert linkage.analyze(mech, [0.3]).status.tolist() == [0]
 
 
 def six_bar_renamed(order: list[int] | None = None) -> MechanismBuilder:
@@ -204,7 +209,7 @@ def test_mobility_mismatch_missing_pair():
 
 
 def test_mobility_mismatch_two_inputs():
-    mech = four_bar_builder(inputs=("1", "3")).build()
+    mech = four_bar_builder(inputs=("1", "3")).input_law("3", ratio=1.0).build()
     with pytest.raises(StructureError, match=r"four_bar.*W.*= 1\b.*2 input.*'1', '3'"):
         linkage.decompose(mech)
 
@@ -399,9 +404,16 @@ def mirrored(mech: linkage.Mechanism) -> linkage.Mechanism:
     ``M u``. A prismatic pair's angle ``g`` (slider x axis relative to the guide direction,
     ``theta_slider - theta_guide_link = a + g``) becomes ``-g``, or ``pi - g`` when the frame is
     the slider (its angle stays 0 instead of becoming pi). Left and right swap; a ``towards``
-    direction ``a`` becomes ``pi - a``.
+    direction ``a`` becomes ``pi - a``. A further input's law ``theta = r phi + p`` becomes, with
+    ``phi -> pi - phi`` and ``theta -> pi - theta``, ``theta = r phi + (pi - r pi - p)``; a table's
+    points ``(phi, theta)`` become ``(pi - phi, pi - theta)`` in reverse order.
     """
     data = kinematic_data(mech)
+    for law in data.get("input_laws", {}).values():
+        if "table" in law:
+            law["table"] = [[math.pi - a, math.pi - b] for a, b in reversed(law["table"])]
+        else:
+            law["phase"] = math.pi - law["ratio"] * math.pi - law["phase"]
     frame = data["frame"]
     for name, spec in data["links"].items():
         if name == frame:

@@ -203,11 +203,13 @@ class _Work:
             import matplotlib.pyplot as plt
 
             fig, ax = plt.subplots(figsize=(7.5, 3.4), layout="constrained")
-            plot_columns(columns, ["balancing_moment"], ax, mechanism=self.mech)
+            plot_columns(columns, [name for name in columns if name.startswith("balancing_moment")], ax,
+                         mechanism=self.mech)
             return fig
 
-        self._picture("balancing_moment", "Balancing moment on the input link (kinetostatics at the scheme's "
-                      "speed)", balancing)
+        self._picture("balancing_moment", "Balancing moment on the input link"
+                      + ("s" if len(self.mech.inputs) > 1 else "") + " (kinetostatics at the scheme's speed)",
+                      balancing)
         self._picture("hodographs", "Hodographs of the reactions in the main pairs",
                       lambda: plot_hodographs(self.forces.reactions))
 

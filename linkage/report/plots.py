@@ -237,11 +237,18 @@ def describe_column(name: str, mechanism: Mechanism | None = None) -> ColumnWord
     """
     unit = unit_for_people(column_unit(name))
     crank = _input_word(mechanism)
+    several = mechanism is not None and len(mechanism.inputs) > 1
     if name in _NAMED:
         words, symbol, kind = _NAMED[name]
         note = _NOTES.get(name, "")
+        if several and name == "balancing_moment":      # several inputs: name the first
+            words, symbol = f"balancing moment on {crank} {mechanism.inputs[0]}", f"$M_{{b,{_sub(mechanism.inputs[0])}}}$"
         return ColumnWords(name, words.format(crank=crank), symbol, unit, kind, note)
     obj, dot, quantity = name.rpartition(".")
+    if obj == "balancing_moment":                       # a further input link's
+        role = link_role(mechanism, quantity) if mechanism is not None and quantity in mechanism.links else "link"
+        return ColumnWords(name, f"balancing moment on {role} {quantity}", f"$M_{{b,{_sub(quantity)}}}$", unit,
+                           "moments", _NOTES["balancing_moment"])
     base = quantity.rstrip("'")
     order = len(quantity) - len(base)
     if not dot or order > 2:

@@ -222,8 +222,8 @@ def column_unit(name: str) -> str | None:
     """The unit of a table column, from its name (None: a count or a pure number).
 
     ``i`` none; ``*_deg`` deg; ``P.x P.y K.s`` m (with ``'`` m/rad, ``''`` m/rad^2);
-    ``L.theta`` rad (rad/rad, rad/rad^2); ``K.R K.Rx K.Ry`` N; ``K.M`` N m; ``balancing_moment``,
-    ``reduced_moment_*`` N m; ``reduced_inertia`` kg m^2; ``reduced_inertia_derivative``
+    ``L.theta`` rad (rad/rad, rad/rad^2); ``K.R K.Rx K.Ry`` N; ``K.M`` N m; ``balancing_moment``
+    and ``balancing_moment.L``, ``reduced_moment_*`` N m; ``reduced_inertia`` kg m^2; ``reduced_inertia_derivative``
     kg m^2/rad; ``omega`` rad/s; ``eps`` rad/s^2; ``t`` s.
 
     >>> [column_unit(n) for n in ("i", "phi_deg", "B.x'", "3.theta''", "A.R", "omega")]
@@ -233,6 +233,8 @@ def column_unit(name: str) -> str | None:
         return "deg"
     if name in _NAMED_UNITS:
         return _NAMED_UNITS[name]
+    if name.startswith("balancing_moment."):      # a further input link's balancing moment
+        return "N m"
     _, dot, quantity = name.rpartition(".")
     if not dot:
         return None
