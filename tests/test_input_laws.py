@@ -265,3 +265,25 @@ def test_cli_refuses_bad_laws_without_a_traceback(argument, message):
     done = run_cli("analyze", "five_bar_two_input", "--input-law", argument)
     assert done.returncode != 0
     assert message in done.stderr and "Traceback" not in done.stderr
+
+
+def test_reduced_inertia_counts_the_second_crank_with_its_law():
+    """I_red(phi) = sum(m v_S^2 + J w^2) / w_1^2 with the kinetic energy computed here (crank 4 at
+    theta_4' = -1 + 0.3 cos(phi), the couplers by central differences of the circle intersection)."""
+    from linkage.reduced import reduced_characteristics
+
+    grid = np.radians(np.arange(0.0, 361.0, 2.0))
+    smooth = lambda p: PHASE - p + 0.3 * np.sin(p)                  # noqa: E731
+    shipped = linkage.load("five_bar_two_input")
+    mech = shipped.with_input_laws(**{"4": InputLaw(table=(tuple(grid), tuple(smooth(grid))))})
+    reduced = reduced_characteristics(mech, PHI, 1)
+    h = 1e-5
+    ahead, behind = five_bar(PHI + h, smooth(PHI + h)), five_bar(PHI - h, smooth(PHI - h))
+    energy = INERTIA["1"] * 1.0                                      # crank 1: com on its pivot
+    for link, com in (("2", "S2"), ("3", "S3")):
+        v = (ahead[com] - behind[com]) / (2 * h)
+        w = ((ahead[link] - behind[link] + np.pi) % (2 * np.pi) - np.pi) / (2 * h)
+        energy = energy + MASS[link] * np.sum(v**2, axis=1) + INERTIA[link] * w**2
+    energy = energy + INERTIA["4"] * (-1 + 0.3 * np.cos(PHI)) ** 2  # crank 4: com on its pivot
+    assert np.max(np.abs(reduced.inertia - energy)) < 1e-5 * np.max(energy)
+    assert reduced.inertia_constant == pytest.approx(INERTIA["1"], rel=1e-12)
