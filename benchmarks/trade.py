@@ -928,6 +928,8 @@ def newton_schemes() -> dict[str, tuple[str, int]]:
         mech = linkage.load(name)
         groups = linkage.structure_of(mech).groups
         has_dynamics = "dynamics" in mech.extra and mech.extra.get("dynamics") is not None
+        if len(mech.inputs) > 1:
+            continue      # the table compares one input's mechanisms
         for i, g in enumerate(groups):
             if isinstance(g, Dyad):
                 candidates.append((g.kind, has_dynamics, len(groups), name, i))
