@@ -26,7 +26,9 @@ A kind subclasses :class:`Group` and fills in
 The public template methods :meth:`Group.position`, :meth:`Group.analogs` and
 :meth:`Group.reactions` add the shared checks (closure, singularity relative to the mechanism
 size) and the shared linear algebra (constraint Jacobian for analogs, its transpose for
-reactions). Status codes per position: ``OK = 0``, ``CANNOT_ASSEMBLE = -1``, ``SINGULAR = -2``.
+reactions). Status codes per position: ``OK = 0``, ``CANNOT_ASSEMBLE = -1``, ``SINGULAR = -2``,
+``NOT_CONVERGED = -4`` (a group solved by Newton's method was given a start but did not reach a
+closed position from it; -3 is a batch's ``linkage.batch.OTHER_BRANCH``).
 """
 
 from __future__ import annotations
@@ -43,6 +45,7 @@ __all__ = [
     "OK",
     "CANNOT_ASSEMBLE",
     "SINGULAR",
+    "NOT_CONVERGED",
     "RevoluteJoint",
     "PrismaticJoint",
     "Group",
@@ -56,6 +59,8 @@ __all__ = [
 ]
 
 OK, CANNOT_ASSEMBLE, SINGULAR = 0, -1, -2
+#: Newton's method was given a start but did not converge, or converged to a point that does not close
+NOT_CONVERGED = -4
 
 #: relative closure residual above which a closed-form position counts as not assembled
 CLOSURE_TOL = 1e-9

@@ -18,14 +18,18 @@ from __future__ import annotations
 
 import numpy as np
 
-from .base import SINGULAR, Group, GroupPosition, Poses
+from .base import CANNOT_ASSEMBLE, NOT_CONVERGED, OK, SINGULAR, Group, GroupPosition, Poses
 
-__all__ = ["NewtonGroup", "NEWTON_STEPS", "newton", "group_class_of"]
+__all__ = ["NewtonGroup", "NEWTON_STEPS", "TRACE_JUMP", "newton", "group_class_of"]
 
 #: most Newton steps per solve
 NEWTON_STEPS = 40
 #: converged when the step is below this fraction of the mechanism's size (angles: rad)
 STEP_TOL = 1e-13
+#: a solution farther than this fraction of the mechanism's size from its start (link angles
+#: weighted by the size) is another assembly mode, not the start's: a traced mode moves less than
+#: this between two samples of its trace
+TRACE_JUMP = 0.1
 
 
 def group_class_of(links, joints) -> str:
@@ -57,7 +61,7 @@ def _roman(n: int) -> str:
     return {4: "IV", 5: "V", 6: "VI", 7: "VII", 8: "VIII"}.get(n, str(n))
 
 
-def newton(group: Group, poses: Poses, start: Poses, steps: int = NEWTON_STEPS):
+def newton(group: Group, poses: Poses, start: Poses, steps: int | None = None):
     """Newton's method on ``group``'s constraints from the ``start`` poses of its links.
 
     Parameters
@@ -66,6 +70,8 @@ def newton(group: Group, poses: Poses, start: Poses, steps: int = NEWTON_STEPS):
         Poses of the known links.
     start : dict of link -> ndarray (N, 3)
         Start poses of the group's links.
+    steps : int, optional
+        Most steps (default :data:`NEWTON_STEPS`, read at each call).
 
     Returns
     -------
@@ -75,6 +81,7 @@ def newton(group: Group, poses: Poses, start: Poses, steps: int = NEWTON_STEPS):
         Where the last step was below ``STEP_TOL`` times the size (rad for angles).
     """
     links = group.links
+    steps = NEWTON_STEPS if steps is None else steps
     q = np.concatenate([np.asarray(start[k], float) for k in links], axis=1).copy()
     N = len(q)
     size = np.broadcast_to(np.asarray(group.size, float), (N,))
@@ -151,30 +158,87 @@ class NewtonGroup(Group):
 
     def position(self, poses: Poses, branch: int = 1, input_error=0.0, start: Poses | None = None) -> GroupPosition:
         """:meth:`Group.position` from ``start`` (the poses of the group's links near the wanted
-        assembly mode, ``(N, 3)`` each; rows with NaN: no start, status -1). Where the kind lists
-        its modes, the listed solution nearest to the start is polished; the position is singular
-        (-2) when a second mode is nearly as near (the start cannot tell them apart)."""
+        assembly mode, ``(N, 3)`` each).
+
+        Where the kind lists its modes, the listed solution nearest to the start is polished. The
+        position is singular (-2) when a second listed mode is nearly as near (the start cannot
+        tell them apart), or when no listed mode lies within :data:`TRACE_JUMP` of the size (the
+        listing lost the start's mode, as it does next to a position where two modes meet; Newton's
+        method then runs from the start itself). Statuses beyond :meth:`Group.position`'s:
+
+        - -1 (cannot be assembled) where the start or a known pose is NaN (the traced mode does
+          not exist there, or an earlier group failed);
+        - -4 (``NOT_CONVERGED``) where Newton's method had a start but did not converge: the point
+          it reached does not close, lies farther than :data:`TRACE_JUMP` of the size from the
+          start (another assembly mode), or closes at a regular position while its last step was
+          still above :data:`STEP_TOL` (a point that closes where the group is singular is -2:
+          there the steps cannot settle). Its poses are NaN; :meth:`closure` gives the residual.
+        """
         if start is None:
             raise ValueError(f"{self!r} is solved by Newton's method and needs start poses (its assembly plan)")
-        ambiguous = None
+        solved, converged, ambiguous = self._reached(poses, start)
+        N = len(converged)
+        size = np.broadcast_to(np.asarray(self.size, float), (N,))
+        with np.errstate(invalid="ignore"):
+            wandered = _distance(self, solved, start) > TRACE_JUMP * size
+        placed = self._checked(poses, solved, _finite_rows(solved) & ~wandered, input_error)
+        started = _finite_rows(start) & _finite_rows({k: poses[k] for k in self.known_links})
+        status = placed.status.copy()
+        status[(status == OK) & ~converged] = NOT_CONVERGED
+        status[started & (status == CANNOT_ASSEMBLE)] = NOT_CONVERGED
+        status[ambiguous & (status == OK)] = SINGULAR
+        unsolved = status == NOT_CONVERGED
+        return GroupPosition({k: np.where(unsolved[:, None], np.nan, v) for k, v in placed.poses.items()}, status,
+                             np.where(unsolved, 0.0, placed.jacobian_sign), placed.conditioning,
+                             np.where(unsolved, np.inf, placed.error_bound))
+
+    def closure(self, poses: Poses, start: Poses) -> np.ndarray:
+        """Closure residual ``(N,)``, m, of the point Newton's method reaches from ``start`` (the
+        solve of :meth:`position`): the largest opening of a pair -- for a revolute pair the
+        distance between its points on the two links, for a prismatic pair the norm of the
+        slider point's offset from the guide and the size times the angle error. NaN where the
+        iteration left the finite numbers."""
+        solved, _, _ = self._reached(poses, start)
+        gaps = self.residual({**poses, **solved})
+        return np.max(np.hypot(gaps[:, 0::2], gaps[:, 1::2]), axis=1)
+
+    def _reached(self, poses: Poses, start: Poses):
+        """Newton's method from ``start``, or from the listed mode nearest to it: the poses
+        reached ``{link: (N, 3)}``, where its last step was below :data:`STEP_TOL`, and where the
+        start cannot tell the listed modes apart (see :meth:`position`)."""
+        ambiguous = np.zeros(len(next(iter(start.values()))), bool)
         listed = self.modes(poses)
         if listed is not None:
             start, ambiguous = _nearest(self, listed, start)
         solved, converged = newton(self, poses, start)
-        finite = np.all(np.isfinite(np.concatenate(list(solved.values()), axis=1)), axis=1)
-        placed = self._checked(poses, solved, converged & finite, input_error)
-        if ambiguous is not None and ambiguous.any():
-            status = np.where(ambiguous & (placed.status == 0), SINGULAR, placed.status)
-            placed = GroupPosition(placed.poses, status, placed.jacobian_sign, placed.conditioning, placed.error_bound)
-        return placed
+        return solved, converged, ambiguous
 
     def _position(self, poses: Poses, branch: int):
         raise ValueError(f"{self!r} is solved by Newton's method from start poses: call position(..., start=...)")
 
 
+def _finite_rows(poses: Poses) -> np.ndarray:
+    """``(N,)``: where every pose of ``poses`` is finite."""
+    return np.all(np.isfinite(np.concatenate([np.asarray(v, float) for v in poses.values()], axis=1)), axis=1)
+
+
+def _distance(group: Group, a: Poses, b: Poses) -> np.ndarray:
+    """Distance ``(N,)``, m, between poses of the group's links (angles wrapped, weighted by the size)."""
+    size = np.asarray(group.size, float)
+    total = 0.0
+    for k in group.links:
+        d = np.asarray(a[k], float) - np.asarray(b[k], float)
+        turn = (d[:, 2] + np.pi) % (2 * np.pi) - np.pi
+        total = total + d[:, 0] ** 2 + d[:, 1] ** 2 + (size * turn) ** 2
+    return np.sqrt(total)
+
+
 def _nearest(group: NewtonGroup, listed, start):
-    """The listed mode nearest to ``start`` at each position, and where a second mode is within
-    twice that distance plus round-off (ambiguous)."""
+    """The listed mode nearest to ``start`` at each position, and where the position is ambiguous:
+    a second mode within twice that distance plus round-off, or no listed mode within
+    :data:`TRACE_JUMP` of the size (the start's mode was not listed: next to a position where two
+    modes meet the polish of the double root may fail); there the start itself is returned, for
+    Newton's method."""
     candidates, valid = listed
     N, K = valid.shape
     reference = np.stack([start[k] for k in group.links], axis=1)          # (N, L, 3)
@@ -189,9 +253,10 @@ def _nearest(group: NewtonGroup, listed, start):
     best, second = order[:, 0], order[:, 1] if K > 1 else order[:, 0]
     rows = np.arange(N)
     d1, d2 = distance[rows, best], distance[rows, second] if K > 1 else np.full(N, np.inf)
-    found = np.isfinite(d1) & np.all(np.isfinite(reference), axis=(1, 2))
-    chosen = {k: np.where(found[:, None], candidates[k][rows, best], np.nan) for k in group.links}
-    ambiguous = found & (d2 < 2.0 * d1 + 1e-9 * size)
+    with np.errstate(invalid="ignore"):
+        found = (d1 <= TRACE_JUMP * size) & np.all(np.isfinite(reference), axis=(1, 2))
+    chosen = {k: np.where(found[:, None], candidates[k][rows, best], start[k]) for k in group.links}
+    ambiguous = np.where(found, d2 < 2.0 * d1 + 1e-9 * size, np.all(np.isfinite(reference), axis=(1, 2)))
     return chosen, ambiguous
 
 

@@ -6,7 +6,7 @@ scheme file (:mod:`linkage.scheme`) or in Python; it is decomposed into Assur gr
 transfer functions (:mod:`linkage.kinematics`).
 """
 
-from .errors import AssemblyError, InputError, LinkageError, SchemeError, StructureError
+from .errors import AssemblyError, ConvergenceError, InputError, LinkageError, SchemeError, StructureError
 from .extremes import extreme_positions, table_angles
 from .kinematics import Motion, analyze, structure_of
 from .batch import VariantMotion, analyze_variants, geometry_of
@@ -17,7 +17,7 @@ from .structure import decompose, mobility
 from . import forces, dynamics  # noqa: F401  (register the [loads] and [dynamics] sections)
 
 __all__ = [
-    "AssemblyError", "InputError", "LinkageError", "SchemeError", "StructureError", "InputLaw",
+    "AssemblyError", "ConvergenceError", "InputError", "LinkageError", "SchemeError", "StructureError", "InputLaw",
     "Mechanism", "MechanismBuilder", "Motion", "VariantMotion", "analyze", "analyze_variants", "decompose",
     "geometry_of", "dumps", "extreme_positions", "load",
     "loads", "mobility", "save", "shipped_schemes", "structure_of", "table_angles",

@@ -20,12 +20,14 @@ through it (``mode = "follow"``).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
+from typing import NamedTuple
 
 import numpy as np
 from scipy.optimize import minimize_scalar
 
-from assur.base import Group, GroupSolution, global_point
+from assur.base import OK, SINGULAR, Group, GroupSolution, global_point
+from assur.generic import TRACE_JUMP, newton
 
 from .errors import SchemeError
 from .model import Mechanism
@@ -58,6 +60,12 @@ class BranchPlan:
         Input angles in [0, 2 pi) where the group's two assembly modes meet, rad.
     swaps : ndarray of bool (K,)
         Whether the continuous motion changes closed-form branch at each change point.
+    track : (ndarray (S,), dict of link -> ndarray (S, 3)) or None
+        For a group solved by Newton's method: its chosen assembly mode sampled at S increasing
+        input angles (rad: the sweep's and those where its step was refined), NaN where the mode
+        does not exist; None for closed forms.
+    periodic : bool
+        Whether the track covers a whole turn (it then wraps around).
     """
 
     branch: int
@@ -65,6 +73,7 @@ class BranchPlan:
     change_points: np.ndarray
     swaps: np.ndarray
     track: tuple[np.ndarray, dict[str, np.ndarray]] | None = None
+    periodic: bool = False
 
     def start(self, phi: np.ndarray) -> dict[str, np.ndarray] | None:
         """Start poses ``{link: (N, 3)}`` at the input angles ``phi`` for a group solved by
@@ -74,8 +83,7 @@ class BranchPlan:
             return None
         sweep, poses = self.track
         phi = np.asarray(phi, dtype=float)
-        full_turn = np.isclose(sweep[-1] - sweep[0] + (sweep[1] - sweep[0]), TWO_PI)
-        if full_turn:
+        if self.periodic:
             at = (phi - sweep[0]) % TWO_PI + sweep[0]
             sweep = np.append(sweep, sweep[0] + TWO_PI)
             poses = {k: np.vstack([v, v[:1]]) for k, v in poses.items()}
@@ -267,8 +275,9 @@ def _rules_per_group(mech: Mechanism, structure: Structure) -> dict:
     for i, g in enumerate(structure.groups):
         if _has_modes(g) and i not in rules:
             pts = sorted({p for k in g.links for p in mech.links[k].points})
-            problems.append(f"group {g!r} has {'two assembly branches' if len(g.branches) > 1 else 'several assembly modes'}"
-                            f": declare which one with an assembly condition on one of its points {pts}")
+            modes = "two assembly branches" if len(g.branches) > 1 else "several assembly modes"
+            problems.append(f"group {g!r} has {modes}: declare which one with an assembly condition on one of "
+                            f"its points {pts}")
     if problems:
         raise SchemeError([f"mechanism '{mech.name}': {p}" for p in problems])
     return rules
@@ -305,19 +314,36 @@ def _rule_score(mech: Mechanism, rule, poses) -> np.ndarray:
 
 #: multi-start guesses at the first angle for a group that cannot list its modes
 STARTS = 64
-#: a traced mode ends where its nearest solution at the next sweep angle is farther than this
-#: fraction of the mechanism's size (the mode ceased to exist there)
-TRACE_JUMP = 0.1
+#: halvings of a sweep step tried where a traced mode jumps or Newton's method fails between two
+#: sweep angles (the step shrinks to 1/16 of the sweep's) before the mode is declared ended there
+REFINEMENTS = 4
+
+
+class _Trace(NamedTuple):
+    """One assembly mode followed over the sweep: its poses ``{link: (M, 3)}`` at the sweep's M
+    angles (NaN where it does not exist) and the poses ``{link: (E, 3)}`` at the E angles
+    ``refined_at`` (rad) between them where the step was refined."""
+
+    rows: dict[str, np.ndarray]
+    refined_at: np.ndarray
+    refined: dict[str, np.ndarray]
 
 
 def _traced_plan(mech, structure, plans, i, rule, poses, phi) -> BranchPlan:
     """The plan of a group solved by Newton's method: each assembly mode found at the sweep's
-    angles and followed from angle to angle (nearest listed solution, or Newton's method from the
-    previous angle); the declared condition chooses one (as for two branches)."""
+    angles and followed from angle to angle with step control (nearest listed solution, or
+    Newton's method from the previous angle); the declared condition chooses one (as for two
+    branches); the change points where the chosen mode meets another are recorded."""
     group = structure.groups[i]
     known = {k: poses[k] for k in group.known_links}
+
+    def known_at(angles: np.ndarray) -> dict[str, np.ndarray]:
+        chain = _chain(mech, structure, plans, i, np.asarray(angles, float))
+        return {k: chain[k] for k in group.known_links}
+
+    periodic = mech.input_range is None
     listed = group.modes(known)
-    traces = _linked(group, listed) if listed is not None else _continued(group, known)
+    traces = _follow(group, phi, known, known_at, periodic, listed)
     traces = _distinct(group, traces)
     if not traces:
         _never_assembles(mech, group, known)
@@ -326,7 +352,7 @@ def _traced_plan(mech, structure, plans, i, rule, poses, phi) -> BranchPlan:
     else:
         scores = []
         for trace in traces:
-            trial = {**poses, **trace}
+            trial = {**poses, **trace.rows}
             score = _rule_score(mech, rule, trial)
             if rule.phi is not None:
                 near = int(np.argmin(np.abs((phi - rule.phi + np.pi) % TWO_PI - np.pi)))
@@ -340,83 +366,191 @@ def _traced_plan(mech, structure, plans, i, rule, poses, phi) -> BranchPlan:
                 f"the assembly modes of {group!r} apart (two of its {len(traces)} modes satisfy it at "
                 f"{scores[order[0]]} of {len(phi)} input angles; choose a condition that only one mode meets)")
         chosen = int(order[0])
-    return BranchPlan(1, "keep", np.empty(0), np.empty(0, bool), (phi.copy(), traces[chosen]))
+    plan = BranchPlan(1, "keep", np.empty(0), np.empty(0, bool), _track(phi, traces[chosen], periodic), periodic)
+    changes = _traced_change_points(mech, group, known, known_at, plan, phi, traces[chosen].rows)
+    return replace(plan, change_points=changes, swaps=np.zeros(len(changes), bool))
 
 
-def _linked(group, listed) -> list[dict[str, np.ndarray]]:
-    """Modes followed over the sweep from the listed solutions ``({link: (M, K, 3)}, valid (M, K))``."""
-    candidates, valid = listed
-    M = len(valid)
-    present = np.flatnonzero(valid.any(axis=1))
-    if not len(present):
+def _track(phi: np.ndarray, trace: _Trace, periodic: bool) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+    """The samples of a trace, sweep angles and refined ones, in increasing angle (over a turn,
+    folded into the turn that starts at the sweep's first angle)."""
+    angles = np.concatenate([phi, trace.refined_at])
+    if periodic:
+        angles = (angles - phi[0]) % TWO_PI + phi[0]
+    order = np.argsort(angles, kind="stable")
+    return angles[order], {k: np.concatenate([v, trace.refined[k]])[order] for k, v in trace.rows.items()}
+
+
+def _follow(group, phi, known, known_at, periodic: bool, listed) -> list[_Trace]:
+    """Every assembly mode found at the first sweep angle where there is one and followed over
+    the sweep ``phi`` (M angles; over a turn, round to the angle before the first).
+
+    ``known``: poses ``{link: (M, 3)}`` of the group's known links at the sweep; ``known_at``:
+    the same at any angles (rad, ``(n,)``); ``listed``: :meth:`NewtonGroup.modes` at the sweep,
+    or None (the modes are then found by Newton's method from :data:`STARTS` random starts at the
+    first angle and continued by Newton's method). Where a mode jumps by more than
+    :data:`TRACE_JUMP` of the size or Newton's method fails between two sweep angles, the step is
+    halved up to :data:`REFINEMENTS` times (:func:`_refine`); a mode that still cannot be
+    followed ends there (NaN from there on).
+    """
+    M = len(phi)
+    size = float(np.max(group.size))
+    if listed is None:
+        first, starts = 0, _multi_start(group, {k: v[:1] for k, v in known.items()}, size)
+    else:
+        present = np.flatnonzero(listed[1].any(axis=1))
+        first = int(present[0]) if len(present) else 0
+        slots = np.flatnonzero(listed[1][first])
+        starts = {k: v[first, slots] for k, v in listed[0].items()}
+    count = len(next(iter(starts.values())))
+    if not count:
         return []
-    first = int(present[0])
-    size = float(np.max(group.size))
-    traces = []
-    for slot in np.flatnonzero(valid[first]):
-        trace = {k: np.full((M, 3), np.nan) for k in candidates}
-        current = {k: v[first, slot] for k, v in candidates.items()}
-        for k in candidates:
-            trace[k][first] = current[k]
-        for step in range(1, M):
-            m = (first + step) % M
-            gap = sum(_pose_distance(v[m], current[k], size) ** 2 for k, v in candidates.items())
-            gap = np.where(valid[m], np.sqrt(gap), np.inf)
-            best = int(np.argmin(gap))
-            if not np.isfinite(gap[best]) or gap[best] > TRACE_JUMP * size:
-                break
-            current = {k: v[m, best] for k, v in candidates.items()}
-            for k in candidates:
-                trace[k][m] = current[k]
-        traces.append(trace)
-    return traces
+    rows = {k: np.full((M, count, 3), np.nan) for k in group.links}
+    for k in group.links:
+        rows[k][first] = starts[k]
+    refined_at, refined_from, refined = [], [], {k: [] for k in group.links}
+    step = phi[1] - phi[0]
+    current, angle = starts, phi[first]
+    for m in ((first + s) % M for s in range(1, M)) if periodic else range(first + 1, M):
+        options = None if listed is None else ({k: v[m:m + 1] for k, v in listed[0].items()}, listed[1][m:m + 1])
+        reached, ok = _advance(group, current, {k: v[m:m + 1] for k, v in known.items()}, options, size)
+        retry = np.flatnonzero(~ok & _finite(current))
+        if len(retry):
+            fixed, good, samples = _refine(group, {k: v[retry] for k, v in current.items()}, angle, step,
+                                           known_at, listed is not None, size)
+            for k in group.links:
+                reached[k][retry] = fixed[k]
+            ok[retry] = good
+            for j, at, poses in samples:
+                refined_at.append(at)
+                refined_from.append(np.full(len(at), retry[j]))
+                for k in group.links:
+                    refined[k].append(poses[k])
+        current = {k: np.where(ok[:, None], v, np.nan) for k, v in reached.items()}
+        for k in group.links:
+            rows[k][m] = current[k]
+        angle = angle + step
+    at = np.concatenate(refined_at) if refined_at else np.empty(0)
+    owner = np.concatenate(refined_from) if refined_from else np.empty(0, int)
+    extra = {k: np.concatenate(v) if v else np.empty((0, 3)) for k, v in refined.items()}
+    return [_Trace({k: v[:, c] for k, v in rows.items()}, at[owner == c], {k: v[owner == c] for k, v in extra.items()})
+            for c in range(count)]
 
 
-def _continued(group, known) -> list[dict[str, np.ndarray]]:
-    """Modes found by Newton's method from many starts at the first sweep angle and continued from
-    each angle to the next (a mode ends where Newton's method fails)."""
-    from assur.generic import newton
-
-    M = len(next(iter(known.values())))
-    size = float(np.max(group.size))
+def _multi_start(group, at0: dict[str, np.ndarray], size: float) -> dict[str, np.ndarray]:
+    """The distinct solutions ``{link: (C, 3)}`` Newton's method reaches from :data:`STARTS`
+    random starts at the known poses ``at0`` (one position)."""
     rng = np.random.default_rng(0)
-    at0 = {k: np.repeat(v[:1], STARTS, axis=0) for k, v in known.items()}
-    anchors = group.contact_points({**{k: v[:1] for k, v in known.items()},
-                                    **{k: np.zeros((1, 3)) for k in group.links}})
+    known = {k: np.repeat(v, STARTS, axis=0) for k, v in at0.items()}
+    anchors = group.contact_points({**at0, **{k: np.zeros((1, 3)) for k in group.links}})
     centre = np.nanmean(anchors[0], axis=0)
     guesses = {k: np.column_stack([centre[0] + size * rng.uniform(-1, 1, STARTS),
                                    centre[1] + size * rng.uniform(-1, 1, STARTS),
                                    rng.uniform(-np.pi, np.pi, STARTS)]) for k in group.links}
-    solved, converged = newton(group, at0, guesses)
-    closure = np.max(np.abs(group.residual({**at0, **solved})), axis=1)
+    solved, converged = newton(group, known, guesses)
+    closure = np.max(np.abs(group.residual({**known, **solved})), axis=1)
     with np.errstate(invalid="ignore"):
-        good = converged & (closure <= 1e-9 * size)
-    starts = [{k: v[n] for k, v in solved.items()} for n in np.flatnonzero(good)]
-    starts = [t for t in _distinct(group, [{k: v[None] for k, v in s.items()} for s in starts])]
-    if not starts:
-        return []
-    count = len(starts)
-    traces = {k: np.full((M, count, 3), np.nan) for k in group.links}
-    for k in group.links:
-        traces[k][0] = np.concatenate([s[k] for s in starts])
-    for m in range(1, M):
-        here = {k: np.repeat(v[m:m + 1], count, axis=0) for k, v in known.items()}
-        solved, converged = newton(group, here, {k: traces[k][m - 1] for k in group.links})
-        moved = sum(_pose_distance(solved[k], traces[k][m - 1], size) ** 2 for k in group.links)
-        keep = converged & (np.sqrt(moved) <= TRACE_JUMP * size)
+        good = np.flatnonzero(converged & (closure <= 1e-9 * size))
+    kept: list[int] = []
+    for n in good:
+        gap = [np.sqrt(sum(_pose_distance(solved[k][n], solved[k][j], size) ** 2 for k in group.links)) for j in kept]
+        if all(g > 1e-6 * size for g in gap):
+            kept.append(int(n))
+    return {k: v[kept] for k, v in solved.items()}
+
+
+def _advance(group, current, known, options, size: float):
+    """One step of every trace: from its poses ``current`` ``{link: (C, 3)}`` to the next angle,
+    where the known links have the poses ``known`` ``{link: (1, 3)}`` and the listed modes are
+    ``options`` (``({link: (1, K, 3)}, valid (1, K))``, or None). Each trace takes the listed
+    mode nearest to it, else (none listed, or none near: a listing may lose a mode next to a
+    position where two modes meet) the point Newton's method reaches from it. Returns the poses
+    reached and where the step is good: a position that closes to 1e-9 of the size, within
+    :data:`TRACE_JUMP` of the size of the current one."""
+    C = len(next(iter(current.values())))
+    reached = {k: np.full((C, 3), np.nan) for k in group.links}
+    if options is not None:
+        candidates, valid = options
+        gap2 = sum(_pose_distance(candidates[k][0][None], current[k][:, None], size) ** 2 for k in group.links)
+        gap2 = np.where(valid[0][None], np.nan_to_num(gap2, nan=np.inf), np.inf)            # (C, K)
+        best = np.argmin(gap2, axis=1)
+        reached = {k: candidates[k][0][best] for k in group.links}
+    ok = _moved(group, reached, current, size) <= TRACE_JUMP * size
+    rows = np.flatnonzero(~ok & _finite(current))
+    if len(rows):
+        here = {k: np.repeat(v, len(rows), axis=0) for k, v in known.items()}
+        solved, _ = newton(group, here, {k: v[rows] for k, v in current.items()})
+        closure = np.max(np.abs(group.residual({**here, **solved})), axis=1)
+        with np.errstate(invalid="ignore"):
+            ok[rows] = (closure <= 1e-9 * size) & (_moved(group, solved, {k: v[rows] for k, v in current.items()},
+                                                          size) <= TRACE_JUMP * size)
         for k in group.links:
-            traces[k][m] = np.where(keep[:, None], solved[k], np.nan)
-    return [{k: traces[k][:, c] for k in group.links} for c in range(count)]
+            reached[k][rows] = solved[k]
+    return reached, ok
 
 
-def _distinct(group, traces) -> list[dict[str, np.ndarray]]:
+def _moved(group, a: dict[str, np.ndarray], b: dict[str, np.ndarray], size: float) -> np.ndarray:
+    """Distance ``(C,)``, m, between poses of the group's links (``inf`` where one is NaN)."""
+    gap = np.sqrt(sum(_pose_distance(a[k], b[k], size) ** 2 for k in group.links))
+    return np.nan_to_num(gap, nan=np.inf)
+
+
+def _refine(group, current, angle: float, step: float, known_at, listing: bool, size: float):
+    """Follow the R traces at poses ``current`` ``{link: (R, 3)}`` (at the input angle ``angle``)
+    to ``angle + step`` in 2, 4 ... 2**REFINEMENTS equal sub-steps, until every sub-step is good.
+
+    Returns
+    -------
+    reached : dict of link -> ndarray (R, 3)
+        Poses at ``angle + step`` (NaN where the trace could not be followed).
+    good : ndarray of bool (R,)
+    samples : list of (j, angles (n-1,), {link: (n-1, 3)})
+        The poses of trace j at the intermediate sub-angles, rad.
+    """
+    R = len(next(iter(current.values())))
+    reached = {k: np.full((R, 3), np.nan) for k in group.links}
+    good = np.zeros(R, bool)
+    samples = []
+    todo = np.arange(R)
+    for depth in range(1, REFINEMENTS + 1):
+        n = 2**depth
+        angles = angle + step * np.arange(1, n + 1) / n
+        known = known_at(angles)
+        listed = group.modes(known) if listing else None
+        q = {k: v[todo] for k, v in current.items()}
+        alive = np.ones(len(todo), bool)
+        path = {k: np.empty((n, len(todo), 3)) for k in group.links}
+        for f in range(n):
+            options = None if listed is None else ({k: v[f:f + 1] for k, v in listed[0].items()}, listed[1][f:f + 1])
+            q, ok = _advance(group, q, {k: v[f:f + 1] for k, v in known.items()}, options, size)
+            alive &= ok
+            q = {k: np.where(alive[:, None], v, np.nan) for k, v in q.items()}
+            for k in group.links:
+                path[k][f] = q[k]
+        for j in np.flatnonzero(alive):
+            samples.append((int(todo[j]), angles[:-1], {k: path[k][:-1, j] for k in group.links}))
+            for k in group.links:
+                reached[k][todo[j]] = path[k][-1, j]
+        good[todo[alive]] = True
+        todo = todo[~alive]
+        if not len(todo):
+            break
+    return reached, good, samples
+
+
+def _finite(poses: dict[str, np.ndarray]) -> np.ndarray:
+    """``(N,)``: where every pose of ``poses`` is finite."""
+    return np.all(np.concatenate([np.isfinite(v) for v in poses.values()], axis=1), axis=1)
+
+
+def _distinct(group, traces: list[_Trace]) -> list[_Trace]:
     """Traces with the ones that coincide with an earlier one (at every angle both exist) removed."""
     size = float(np.max(group.size))
-    kept = []
+    kept: list[_Trace] = []
     for trace in traces:
         same = False
         for other in kept:
-            gap = np.sqrt(sum(_pose_distance(trace[k], other[k], size) ** 2 for k in trace))
+            gap = np.sqrt(sum(_pose_distance(trace.rows[k], other.rows[k], size) ** 2 for k in trace.rows))
             both = np.isfinite(gap)
             if both.any() and np.all(gap[both] <= 1e-6 * size):
                 same = True
@@ -431,6 +565,37 @@ def _pose_distance(a: np.ndarray, b: np.ndarray, size: float) -> np.ndarray:
     d = a - b
     turn = (d[..., 2] + np.pi) % TWO_PI - np.pi
     return np.sqrt(d[..., 0] ** 2 + d[..., 1] ** 2 + (size * turn) ** 2)
+
+
+def _traced_change_points(mech, group, known, known_at, plan: BranchPlan, phi, rows) -> np.ndarray:
+    """Input angles in [0, 2 pi) where the traced mode ``rows`` ``{link: (M, 3)}`` (the plan's)
+    meets another mode: a local minimum of the group's conditioning along it, refined by a bounded
+    minimisation to below :data:`CHANGE_POINT_TOL`, with the mode assembled on both sides (not a
+    limit position where the mode ends)."""
+    M = len(phi)
+    r = np.full(M, np.nan)
+    ok = _finite(rows)
+    if ok.any():
+        merged = {**{k: v[ok] for k, v in known.items()}, **{k: v[ok] for k, v in rows.items()}}
+        r[ok] = group.conditioning(group.jacobians(merged)[0], merged)[0]
+
+    def placed(x: np.ndarray):
+        x = np.asarray(x, float)
+        return group.position(known_at(x), start=plan.start(x))
+
+    def measure(x: float) -> float:
+        value = placed(np.array([x])).conditioning[0]
+        return float(value) if np.isfinite(value) else 2.0
+
+    found: list[float] = []
+    for x in _conditioning_minima(mech, phi, r, measure):
+        sides = placed(x + CROSSING_STEP * np.array([-1.0, 1.0])).status
+        if np.any((sides != OK) & (sides != SINGULAR)):
+            continue    # the mode ends there: a limit position
+        angle = x % TWO_PI
+        if all(abs((angle - a + np.pi) % TWO_PI - np.pi) >= 1e-9 for a in found):
+            found.append(angle)
+    return np.sort(np.asarray(found, float))
 
 
 # ----------------------------------------------------------------------------------------------
@@ -452,6 +617,30 @@ def _change_points(mech, structure, plans, i, phi, r) -> tuple[np.ndarray, np.nd
     """Angles in [0, 2 pi) where group ``i``'s assembly modes meet (from its conditioning ``r``
     over the sweep ``phi``), and whether the motion swaps closed-form branch there."""
     group = structure.groups[i]
+
+    def measure(x: float) -> float:
+        value = group.position(_chain(mech, structure, plans, i, np.array([x])), 1).conditioning[0]
+        return float(value) if np.isfinite(value) else 2.0
+
+    found, swaps = [], []
+    for x in _conditioning_minima(mech, phi, r, measure):
+        swap = _swaps(mech, structure, plans, i, x)
+        if swap is None:
+            continue  # one side cannot be assembled: a limit position, not a change point
+        angle = x % TWO_PI
+        if any(abs((angle - a + np.pi) % TWO_PI - np.pi) < 1e-9 for a in found):
+            continue
+        found.append(angle)
+        swaps.append(swap)
+    order = np.argsort(found)
+    return np.asarray(found, float)[order], np.asarray(swaps, bool)[order]
+
+
+def _conditioning_minima(mech, phi, r, measure) -> list[float]:
+    """Input angles (rad) where the conditioning falls below :data:`CHANGE_POINT_TOL`: each local
+    minimum of ``r`` (the conditioning over the sweep ``phi``, NaN where not assembled) below 0.1,
+    and each single unassembled angle between two assembled ones, refined by a bounded
+    minimisation of ``measure(x)`` (the conditioning at the input angle x) within a sweep step."""
     ok = np.isfinite(r)
     low = np.where(ok, r, np.inf)
     before, after = np.roll(low, 1), np.roll(low, -1)
@@ -463,27 +652,13 @@ def _change_points(mech, structure, plans, i, phi, r) -> tuple[np.ndarray, np.nd
     cells = np.flatnonzero(inside & (~ok | (low <= np.minimum(before, after)))
                            & (np.minimum(low, np.minimum(before, after)) < 0.1))
     step = abs(phi[1] - phi[0])
-
-    def measure(x: float) -> float:
-        value = group.position(_chain(mech, structure, plans, i, np.array([x])), 1).conditioning[0]
-        return float(value) if np.isfinite(value) else 2.0
-
-    found, swaps = [], []
+    minima = []
     for k in cells:
         best = minimize_scalar(measure, bounds=(phi[k] - step, phi[k] + step), method="bounded",
                                options={"xatol": 1e-12})
-        if best.fun > CHANGE_POINT_TOL:
-            continue
-        swap = _swaps(mech, structure, plans, i, float(best.x))
-        if swap is None:
-            continue  # one side cannot be assembled: a limit position, not a change point
-        angle = float(best.x) % TWO_PI
-        if any(abs((angle - a + np.pi) % TWO_PI - np.pi) < 1e-9 for a in found):
-            continue
-        found.append(angle)
-        swaps.append(swap)
-    order = np.argsort(found)
-    return np.asarray(found, float)[order], np.asarray(swaps, bool)[order]
+        if best.fun <= CHANGE_POINT_TOL:
+            minima.append(float(best.x))
+    return minima
 
 
 # Lagrange weights that extrapolate values at t = -3, -2, -1 to t = 1, 2, 3 (rows)

@@ -5,6 +5,7 @@
 - :class:`SchemeError` -- a mechanism is declared wrongly (bad file, unknown link, bad value);
 - :class:`StructureError` -- the mechanism's structure is wrong (mobility, not decomposable);
 - :class:`AssemblyError` -- a group cannot be assembled at some input angles;
+  :class:`ConvergenceError` when Newton's method did not converge there for a group it solves;
 - :class:`InputError` -- a function of the library was called with a bad argument (an order, a
   direction, a motion without the analogs a computation needs);
 - :class:`DynamicsError` -- the machine stalls, runs away, has no steady state, or its numbers
@@ -16,7 +17,7 @@
 
 from __future__ import annotations
 
-__all__ = ["LinkageError", "SchemeError", "StructureError", "AssemblyError", "InputError",
+__all__ = ["LinkageError", "SchemeError", "StructureError", "AssemblyError", "ConvergenceError", "InputError",
            "DynamicsError", "DynamicsInputError"]
 
 
@@ -54,6 +55,36 @@ class AssemblyError(LinkageError):
     def __init__(self, message: str, angles_deg=()):
         self.angles_deg = angles_deg
         super().__init__(message)
+
+
+class ConvergenceError(AssemblyError):
+    """Newton's method, started from a group's traced assembly mode, did not converge at some
+    input angles (or converged to a point that does not close, or to another mode): status -4,
+    ``assur.base.NOT_CONVERGED``. The message names the group, the angles and the closure
+    residual at each.
+
+    Attributes
+    ----------
+    angles_deg : numpy.ndarray
+        Every offending input angle in degrees (as :class:`AssemblyError`).
+    group : str
+        The group (e.g. ``"III(2,3,4,5)"``); the first one when several did not converge.
+    not_converged_deg : numpy.ndarray (K,)
+        The input angles where Newton's method did not converge for ``group``, deg.
+    residual : numpy.ndarray (K,)
+        The closure residual of the point it reached at each of them, m: the largest opening of
+        one of the group's pairs (:meth:`assur.generic.NewtonGroup.closure`).
+    size : float
+        The mechanism's size, m (``residual / size`` is the relative residual).
+    """
+
+    def __init__(self, message: str, angles_deg=(), group: str = "", not_converged_deg=(), residual=(),
+                 size: float = 1.0):
+        super().__init__(message, angles_deg)
+        self.group = group
+        self.not_converged_deg = not_converged_deg
+        self.residual = residual
+        self.size = size
 
 
 class InputError(LinkageError, ValueError):

@@ -110,6 +110,7 @@ def _find_extremes(mech: Mechanism, quantity: str, samples: int, xtol: float) ->
     motion = analyze(mech, grid, order=1, outputs=[quantity], on_failure="mask")
     d1 = motion.quantity(quantity)[1]
     if not np.isfinite(d1).any():
+        _raise_unconverged(mech, grid, quantity, motion.status)
         raise InputError(f"mechanism '{mech.name}' cannot be assembled at any input angle")
     scale = 1.0 if quantity.endswith(".theta") else mech.size  # an angle's analog is in rad/rad
     if not np.nanmax(np.abs(d1)) > 1e-12 * scale:
@@ -134,6 +135,15 @@ def _find_extremes(mech: Mechanism, quantity: str, samples: int, xtol: float) ->
                     float(values[i_min]), roots)
 
 
+def _raise_unconverged(mech: Mechanism, grid: np.ndarray, quantity: str, status: np.ndarray) -> None:
+    """Where Newton's method did not converge, raise its :class:`~linkage.errors.ConvergenceError`
+    (naming the group, the angles and the residuals) rather than "cannot be assembled"."""
+    from assur.base import NOT_CONVERGED
+
+    if np.any(status == NOT_CONVERGED):
+        analyze(mech, grid[status == NOT_CONVERGED], order=1, outputs=[quantity])
+
+
 def _find_extremes_in_range(mech: Mechanism, quantity: str, samples: int, xtol: float,
                             derivative) -> Extremes:
     """Extremes within ``mech.input_range``: among the roots of the analog inside it (found as
@@ -143,6 +153,7 @@ def _find_extremes_in_range(mech: Mechanism, quantity: str, samples: int, xtol: 
     motion = analyze(mech, grid, order=1, outputs=[quantity], on_failure="mask")
     value, d1, _ = motion.quantity(quantity)
     if not np.isfinite(d1).any():
+        _raise_unconverged(mech, grid, quantity, motion.status)
         raise InputError(f"mechanism '{mech.name}' cannot be assembled at any input angle of its range")
     scale = 1.0 if quantity.endswith(".theta") else mech.size
     if not np.nanmax(np.abs(d1)) > 1e-12 * scale:

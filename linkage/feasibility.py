@@ -41,6 +41,7 @@ import numpy as np
 
 from assur.base import (
     CANNOT_ASSEMBLE,
+    NOT_CONVERGED,
     SINGULAR,
     Group,
     PrismaticJoint,
@@ -423,6 +424,17 @@ def _assembles_somewhere(sweep: _Sweep) -> str | None:
     return None
 
 
+def _solved(sweep: _Sweep) -> str | None:
+    """A group solved by Newton's method that did not converge: the solver failed, so nothing can
+    be said of the geometry there (docs/groups.md)."""
+    failed = sweep.motion.status == NOT_CONVERGED
+    if not failed.any():
+        return None
+    return (f"{sweep.name}: Newton's method did not converge for a group without a closed form at phi = "
+            f"{_spans_text(sweep.mech, sweep.motion.phi, failed)} deg ({int(failed.sum())} of "
+            f"{len(sweep.motion.phi)} input angles checked): the geometry there is unknown")
+
+
 def _turns_fully(sweep: _Sweep) -> str | None:
     phi = sweep.motion.phi
     failed = (sweep.motion.status == CANNOT_ASSEMBLE) & ~sweep.excused
@@ -483,13 +495,15 @@ def _stroke_within_bounds(sweep: _Sweep) -> str | None:
 #: (rule, whether the requirements ask for it, the judge: reason or None), in the order of RULES
 _RULE_CHECKS = (
     ("assembles", lambda req: True, _assembles_somewhere),
+    ("solved", lambda req: True, _solved),
     ("full_rotation", lambda req: req.full_rotation, _turns_fully),
     ("non_singular", lambda req: req.non_singular, _stays_regular),
     ("no_change_point", lambda req: req.no_change_point, _passes_no_change_point),
     ("transmission_angle", lambda req: req.min_transmission_angle_deg is not None, _transmits_well),
     ("stroke", lambda req: req.stroke is not None, _stroke_within_bounds),
 )
-#: the rules in the order :func:`check` applies them: "assembles", "full_rotation", "non_singular",
+#: the rules in the order :func:`check` applies them: "assembles", "solved" (Newton's method converged
+#: wherever a group without a closed form was solved), "full_rotation", "non_singular",
 #: "no_change_point", "transmission_angle", "stroke"
 RULES = tuple(rule for rule, _, _ in _RULE_CHECKS)
 
@@ -596,7 +610,7 @@ def _stroke(mech: Mechanism, motion: Motion) -> float | None:
     """max - min of the output quantity over the travel (m or rad), refined between the sweep's
     angles (with the analogs when the motion has them); None without an output or when some angle
     of the travel does not assemble."""
-    if mech.output is None or np.any(motion.status == CANNOT_ASSEMBLE):
+    if mech.output is None or np.any((motion.status == CANNOT_ASSEMBLE) | (motion.status == NOT_CONVERGED)):
         return None
     quantity = mech.output.quantity
     values, slopes, _ = motion.quantity(quantity)
@@ -615,7 +629,7 @@ def _figures(sweep: _Sweep) -> dict:
     """The measured values of :attr:`Verdict.figures`."""
     mech, motion, changes, angles, stroke = sweep.mech, sweep.motion, sweep.changes, sweep.angles, sweep.stroke
     status = motion.status
-    assembled = status != CANNOT_ASSEMBLE
+    assembled = (status != CANNOT_ASSEMBLE) & (status != NOT_CONVERGED)
     worst = _worst_group(motion, assembled) if assembled.any() else (None, None)
     return {
         "positions": len(motion.phi),

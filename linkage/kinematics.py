@@ -69,7 +69,8 @@ class Motion:
     poses, first, second : dict of link -> ndarray (N, 3)
         Poses ``(x, y, theta)`` and their first / second analogs (``None`` when not computed).
     status : ndarray of int, shape (N,)
-        0 ok, -1 cannot be assembled, -2 singular (analogs unbounded; they are NaN there).
+        0 ok, -1 cannot be assembled, -2 singular (analogs unbounded; they are NaN there), -4 a
+        group solved by Newton's method did not converge (docs/groups.md; values NaN there).
     omega, eps : ndarray (N,) or None
         Input angular velocity (rad/s) and acceleration (rad/s^2) for real velocities.
     conditioning : dict of group label -> ndarray (N,)
@@ -323,7 +324,9 @@ def analyze(
         for real velocities and accelerations.
     on_failure : {"raise", "mask"}
         ``"raise"`` (default): :class:`AssemblyError` listing the input angles where a group
-        cannot be assembled or is singular. ``"mask"``: return them in ``Motion.status``.
+        cannot be assembled or is singular (:class:`~linkage.errors.ConvergenceError`, naming the
+        group and the residual, where Newton's method did not converge). ``"mask"``: return them
+        in ``Motion.status``.
 
     Returns
     -------
@@ -350,7 +353,7 @@ def analyze(
             _check_jumps(group, plans[i], run.poses, run.first, run.solved[i], phi)
     status, bad = run.status, run.status != OK
     if on_failure == "raise" and bad.any():
-        raise AssemblyError(_failure_message(mech, phi, status, run.conditioning), np.degrees(phi[bad]))
+        raise _failure(mech, phi, run, structure, plans, list(group_ids))
     poses, first, second = run.poses, run.first, run.second
     omega_arr = eps_arr = None
     if omega is not None:
@@ -537,13 +540,38 @@ def input_poses(mech: Mechanism, structure: Structure, phi: np.ndarray) -> dict[
     return poses
 
 
-def _failure_message(mech: Mechanism, phi: np.ndarray, status: np.ndarray, conditioning: dict) -> str:
+def _failure(mech: Mechanism, phi: np.ndarray, run: _Run, structure: Structure, plans, group_ids: list[int]
+             ) -> AssemblyError:
+    """The error of :func:`analyze` for the positions of ``run`` that are not OK, naming the input
+    angles (deg) of each problem: :class:`ConvergenceError` when Newton's method did not converge
+    for a group (its message also names the group and the closure residual at each such angle,
+    recomputed there by :meth:`assur.generic.NewtonGroup.closure`), else :class:`AssemblyError`."""
+    from assur.base import NOT_CONVERGED
+
+    from .errors import ConvergenceError
+
+    status, conditioning = run.status, run.conditioning
     parts = []
     for code, what in ((CANNOT_ASSEMBLE, "cannot be assembled"), (SINGULAR, "is singular")):
         angles = np.degrees(phi[status == code])
         if len(angles):
             shown = ", ".join(f"{a:.6g}" for a in angles[:20]) + (" ..." if len(angles) > 20 else "")
             parts.append(f"{what} at {len(angles)} input angle(s) (deg): {shown}")
+    unconverged = []
+    for i in group_ids:
+        rows = np.flatnonzero(run.solved[i] == NOT_CONVERGED)
+        if not len(rows):
+            continue
+        group = structure.groups[i]
+        known = {k: run.poses[k][rows] for k in group.known_links}
+        residual = group.closure(known, plans[i].start(phi[rows]))
+        size = float(np.max(group.size))
+        angles = np.degrees(phi[rows])
+        unconverged.append((repr(group), angles, residual, size))
+        shown = ", ".join(f"{a:.6g} ({r:.3g} m, {r / size:.3g})" for a, r in zip(angles[:20], residual[:20]))
+        parts.append(f"is not solved at {len(rows)} input angle(s) where Newton's method did not converge for "
+                     f"group {group!r} (deg, closure residual m, relative to the size {size:.6g} m): {shown}"
+                     + (" ..." if len(rows) > 20 else ""))
     singular = status == SINGULAR
     if singular.any():
         worst = {g: float(np.nanmin(r[singular])) for g, r in conditioning.items()
@@ -552,8 +580,13 @@ def _failure_message(mech: Mechanism, phi: np.ndarray, status: np.ndarray, condi
         parts.append(f"group {group} is nearly singular there (conditioning {worst[group]:.2g}, where 1 "
                      f"is well proportioned: too low to keep its analogs to {ANALOG_TOL:g} relative; "
                      "see Motion.conditioning)")
-    return (f"mechanism '{mech.name}' " + "; ".join(parts)
-            + " (use on_failure='mask' to get a per-position status instead)")
+    message = (f"mechanism '{mech.name}' " + "; ".join(parts)
+               + " (use on_failure='mask' to get a per-position status instead)")
+    bad = np.degrees(phi[status != OK])
+    if unconverged:
+        group, angles, residual, size = unconverged[0]
+        return ConvergenceError(message, bad, group, angles, residual, size)
+    return AssemblyError(message, bad)
 
 
 def _check_continuity(group, sign: np.ndarray, branches: np.ndarray, solved: np.ndarray, phi) -> None:
@@ -570,14 +603,21 @@ def _check_continuity(group, sign: np.ndarray, branches: np.ndarray, solved: np.
 
 
 def _check_change_points(group, plan, phi) -> None:
-    """Warn when the analysed angles pass a change point that the group keeps its branch through,
-    or when a followed motion needs two turns to repeat and a whole turn is analysed."""
+    """Warn when the analysed angles pass a change point that the group keeps its branch through
+    (for a group solved by Newton's method: that its traced assembly mode passes), or when a
+    followed motion needs two turns to repeat and a whole turn is analysed."""
     if len(phi) < 2 or not len(plan.change_points):
         return
     if plan.mode == "keep":
         passed = plan.change_points[plan.crossed(phi).any(axis=1)]
-        if len(passed):
-            shown = ", ".join(f"{round(float(np.degrees(c)), 6) % 360 + 0.0:g}" for c in passed)
+        shown = ", ".join(f"{round(float(np.degrees(c)), 6) % 360 + 0.0:g}" for c in passed)
+        if len(passed) and plan.track is not None:      # a group solved by Newton's method
+            warnings.warn(
+                f"group {group!r} passes a change point at input angle(s) {shown} deg, where its traced "
+                "assembly mode meets another: the motion may go on in either there (the position at it "
+                "is singular); past it the group takes the mode its plan traced, the one nearest to "
+                "the motion before it", BranchWarning, stacklevel=3)
+        elif len(passed):
             warnings.warn(
                 f"group {group!r} passes a change point at input angle(s) {shown} deg, where its two "
                 "assembly modes meet; keeping its declared branch it switches assembly mode there "

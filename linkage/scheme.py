@@ -313,12 +313,17 @@ def _check_range_assembles(mech: Mechanism, data: Mapping[str, Any]) -> None:
     the mechanism cannot be assembled (a range is where it assembles)."""
     import numpy as np
 
-    from assur.base import CANNOT_ASSEMBLE
+    from assur.base import CANNOT_ASSEMBLE, NOT_CONVERGED
 
-    from .kinematics import input_sweep
+    from .kinematics import analyze, input_sweep
 
     motion = input_sweep(mech)
     phi = motion.phi
+    if np.any(motion.status == NOT_CONVERGED):   # a solver failure, not the range's: say so (ConvergenceError)
+        try:
+            analyze(mech, phi[motion.status == NOT_CONVERGED], order=0)
+        except LinkageError as exc:
+            raise SchemeError(str(exc)) from None
     bad = np.flatnonzero(motion.status == CANNOT_ASSEMBLE)
     if not len(bad):
         return

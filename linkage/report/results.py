@@ -154,16 +154,19 @@ def table_sense(phi: np.ndarray) -> int:
 
 
 def failures(motion: Motion) -> tuple[list[dict], list[str]]:
-    """The positions of ``motion`` that cannot be assembled or are singular: one JSON entry per
+    """The positions of ``motion`` that cannot be assembled, are singular or where Newton's method
+    did not converge (a group solved by it, docs/groups.md): one JSON entry per
     position (``position``, ``phi_deg``, ``input_angle_deg``, ``problem``; for a singular one the
     least conditioned ``group`` and its ``conditioning``) and one warning line per problem."""
-    from assur.base import CANNOT_ASSEMBLE, SINGULAR
+    from assur.base import CANNOT_ASSEMBLE, NOT_CONVERGED, SINGULAR
 
     failed, lines = [], []
     travelled = table_positions_deg(motion.phi)
     phi_deg = np.degrees(motion.phi)
     for code, what, blank in ((CANNOT_ASSEMBLE, "cannot be assembled", "values are empty (nan)"),
-                              (SINGULAR, "is singular", "analogs are empty (nan)")):
+                              (SINGULAR, "is singular", "analogs are empty (nan)"),
+                              (NOT_CONVERGED, "was not solved: Newton's method did not converge",
+                               "values are empty (nan)")):
         where = np.flatnonzero(motion.status == code)
         if not len(where):
             continue
