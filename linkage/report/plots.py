@@ -1412,6 +1412,7 @@ def _moving_artists(sc: _Scene, geometry: _Geometry) -> list:
 
     mech, u = geometry.mech, geometry.unit
     colour = {link: LINK_COLOURS[k % len(LINK_COLOURS)] for k, link in enumerate(mech.moving_links)}
+    colour[mech.frame] = "0.3"          # a block fixed to the frame, sliding in a moving link's guide
     out = []
     for link, poly in sc.bodies:
         c = colour[link]
