@@ -834,9 +834,11 @@ def _add_enumerate(sub) -> None:
         "enumerate", help="every R/P assignment of a scheme's pairs, each as a scheme that runs a full turn",
         description="Enumerate the pair kinds of a scheme's chain (docs/enumerate.md): every assignment of "
                     "R or P (with the guide on either link) to its pairs but the input's, kept when it "
-                    "decomposes into groups with a closed-form solver (RRR, RRP, RPR, PRP, RPP), the "
-                    "others listed with the reason (--rejected). Each kept combination gets the scheme's "
-                    "own geometry; where it does not run a full turn (assembled, regular, conditioning at "
+                    "decomposes into groups the library solves (the dyads RRR, RRP, RPR, PRP, RPP and the "
+                    "class-III triad in closed form, any other group by Newton's method), the others listed "
+                    "with the reason (--rejected). Each kept combination gets the scheme's own geometry "
+                    "(those with a traced group only with --newton, else 'not searched'); where it does not run "
+                    "a full turn (assembled, regular, conditioning at "
                     f"least {MIN_CONDITIONING:g}, no change point), a shorter crank "
                     f"({', '.join(f'{f:g}' for f in CRANK_FACTORS[1:])} of the scheme's) and three "
                     "further reference positions are tried. Columns: id (e.g. A=R,B=P3,C=R: B "
@@ -851,6 +853,10 @@ def _add_enumerate(sub) -> None:
                    help="write the schemes and the tables into DIR (created)")
     p.add_argument("--omega", metavar="RAD_S", type=_real, default=DEFAULT_OMEGA,
                    help=f"input speed of the balancing moment, rad/s, signed (default {DEFAULT_OMEGA:g})")
+    p.add_argument("--newton", action="store_true",
+                   help="also search a full-turn geometry for the combinations with a group solved by Newton's "
+                        "method (slow: about 1-2 s per trial, minutes for a six-bar); without it they are listed "
+                        "as 'not searched'")
     p.add_argument("--rejected", action="store_true",
                    help="list the rejected assignments and why, instead of the table")
     _add_format_argument(p)
@@ -870,10 +876,10 @@ def _cmd_enumerate(args: argparse.Namespace) -> int:
 
     if args.omega == 0.0:
         raise InputError("--omega 0: the balancing moment needs a nonzero speed, rad/s")
-    found = enumerate_chain(_load_scheme(args), omega=args.omega, progress=progress)
+    found = enumerate_chain(_load_scheme(args), omega=args.omega, newton=args.newton, progress=progress)
     if args.out is not None:
         found.write(args.out)
-    running = sum(c.full_turn for c in found.combinations)
+    running = sum(c.full_turn is True for c in found.combinations)
     meta = {"scheme": found.source, "omega": args.omega,
             "assignments": len(found.combinations) + len(found.rejected), "solvable": len(found.combinations),
             "full_turn": running, "rejected": len(found.rejected)}
@@ -887,10 +893,12 @@ def _cmd_enumerate(args: argparse.Namespace) -> int:
     if not len(columns["id"]):
         _note("note", f"scheme '{found.source}': no {'rejected' if args.rejected else 'solvable'} assignment")
     if args.format == "table":
-        notes = columns.pop("note", None)
+        columns.pop("note", None)
+        skipped = sum(c.full_turn is None for c in found.combinations)
+        unsearched = f"; {skipped} with a traced group not searched, see --newton" if skipped else ""
         meta = {"scheme": found.source,
-                "assignments": f"{meta['assignments']}: {meta['solvable']} decompose into closed-form groups "
-                               f"({running} run a full turn), {meta['rejected']} rejected (see --rejected)",
+                "assignments": f"{meta['assignments']}: {meta['solvable']} decompose into solvable groups "
+                               f"({running} run a full turn{unsearched}), {meta['rejected']} rejected (see --rejected)",
                 "balancing moment": f"peak |M_b| over a turn at omega = {args.omega:g} rad/s, gravity and "
                                     "inertia of the scheme's masses"}
         if args.rejected:  # one line each: the reasons are too long for a column
@@ -898,7 +906,7 @@ def _cmd_enumerate(args: argparse.Namespace) -> int:
             text += "".join(f"{i}: {reason}\n" for i, reason in zip(columns["id"], columns["reason"]))
         else:
             text = format_columns(columns, "table", meta=meta, units=units) if len(columns["id"]) else ""
-            text += "".join(f"# {i}: {n}\n" for i, n in zip(columns["id"], notes) if n)
+            text += "".join(f"# {c.id}: {c.note}\n" for c in found.combinations if c.note and c.full_turn is not None)
         _out(text or f"# scheme: {found.source}")
     else:
         _out(format_columns(columns, args.format, meta=meta if args.format == "json" else None, units=units)
