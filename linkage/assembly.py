@@ -263,7 +263,7 @@ def _rules_per_group(mech: Mechanism, structure: Structure) -> dict:
     problems = []
     for rule in mech.assembly:
         owners = [i for i, g in enumerate(structure.groups)
-                  if _has_modes(g) and any(rule.point in mech.links[k].points for k in g.links)]
+                  if has_modes(g) and any(rule.point in mech.links[k].points for k in g.links)]
         if not owners:
             problems.append(f"assembly of point '{rule.point}': no group with two or more assembly modes "
                             "places this point")
@@ -273,7 +273,7 @@ def _rules_per_group(mech: Mechanism, structure: Structure) -> dict:
         else:
             rules[owners[0]] = rule
     for i, g in enumerate(structure.groups):
-        if _has_modes(g) and i not in rules:
+        if has_modes(g) and i not in rules:
             pts = sorted({p for k in g.links for p in mech.links[k].points})
             modes = "two assembly branches" if len(g.branches) > 1 else "several assembly modes"
             problems.append(f"group {g!r} has {modes}: declare which one with an assembly condition on one of "
@@ -283,7 +283,7 @@ def _rules_per_group(mech: Mechanism, structure: Structure) -> dict:
     return rules
 
 
-def _has_modes(group) -> bool:
+def has_modes(group) -> bool:
     """Whether the group can be assembled in more than one way (a condition must choose)."""
     return len(group.branches) > 1 or getattr(group, "tracked", False)
 
@@ -453,8 +453,9 @@ def _multi_start(group, at0: dict[str, np.ndarray], size: float) -> dict[str, np
         good = np.flatnonzero(converged & (closure <= 1e-9 * size))
     kept: list[int] = []
     for n in good:
-        gap = [np.sqrt(sum(_pose_distance(solved[k][n], solved[k][j], size) ** 2 for k in group.links)) for j in kept]
-        if all(g > 1e-6 * size for g in gap):
+        gap = poses_distance({k: v[n] for k, v in solved.items()}, {k: v[kept] for k, v in solved.items()},
+                             group.links, size)
+        if np.all(gap > 1e-6 * size):
             kept.append(int(n))
     return {k: v[kept] for k, v in solved.items()}
 
@@ -491,7 +492,7 @@ def _advance(group, current, known, options, size: float):
 
 def _moved(group, a: dict[str, np.ndarray], b: dict[str, np.ndarray], size: float) -> np.ndarray:
     """Distance ``(C,)``, m, between poses of the group's links (``inf`` where one is NaN)."""
-    gap = np.sqrt(sum(_pose_distance(a[k], b[k], size) ** 2 for k in group.links))
+    gap = poses_distance(a, b, group.links, size)
     return np.nan_to_num(gap, nan=np.inf)
 
 
@@ -550,7 +551,7 @@ def _distinct(group, traces: list[_Trace]) -> list[_Trace]:
     for trace in traces:
         same = False
         for other in kept:
-            gap = np.sqrt(sum(_pose_distance(trace.rows[k], other.rows[k], size) ** 2 for k in trace.rows))
+            gap = poses_distance(trace.rows, other.rows, trace.rows, size)
             both = np.isfinite(gap)
             if both.any() and np.all(gap[both] <= 1e-6 * size):
                 same = True
@@ -565,6 +566,12 @@ def _pose_distance(a: np.ndarray, b: np.ndarray, size: float) -> np.ndarray:
     d = a - b
     turn = (d[..., 2] + np.pi) % TWO_PI - np.pi
     return np.sqrt(d[..., 0] ** 2 + d[..., 1] ** 2 + (size * turn) ** 2)
+
+
+def poses_distance(a: dict[str, np.ndarray], b: dict[str, np.ndarray], links, size: float) -> np.ndarray:
+    """Distance between the poses ``(..., 3)`` of several links, m: the root of the sum of
+    :func:`_pose_distance` squared over ``links``."""
+    return np.sqrt(sum(_pose_distance(a[k], b[k], size) ** 2 for k in links))
 
 
 def _traced_change_points(mech, group, known, known_at, plan: BranchPlan, phi, rows) -> np.ndarray:

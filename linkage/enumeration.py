@@ -48,8 +48,9 @@ import numpy as np
 from assur.base import OK, SINGULAR, PrismaticJoint, global_point
 from assur.generic import TRACE_JUMP, newton
 
+from .assembly import has_modes, poses_distance
 from .errors import AssemblyError, InputError, LinkageError, SchemeError, StructureError
-from .extremes import extreme_positions
+from .extremes import extreme_positions, wrap_angle
 from .feasibility import check, sweep_angles
 from .forces import loads_of
 from .kinematics import BranchWarning, analyze, input_poses, input_sweep
@@ -377,12 +378,7 @@ def _declare_pairs(builder: MechanismBuilder, geometry: _Geometry, source: Mecha
         guide = geometry.new_guide_name(guide_link, name)
         geometry.guides[guide_link][guide] = (ref.to_local(guide_link, where), direction - ref.poses[guide_link][2])
         builder.prismatic(name, guide_link, slider, guide=guide, at=point,
-                          angle=_wrapped(ref.poses[slider][2] - direction))
-
-
-def _wrapped(angle: float) -> float:
-    """The angle in [-pi, pi), rad."""
-    return (angle + math.pi) % (2 * math.pi) - math.pi
+                          angle=wrap_angle(ref.poses[slider][2] - direction))
 
 
 def _scaled_crank(geometry: _Geometry, source: Mechanism, factor: float) -> tuple[float, float]:
@@ -472,15 +468,10 @@ def _branches(structure: Structure, ref: Reference) -> dict[int, int]:
             with np.errstate(all="ignore"):   # a link of zero length (a pin where a slider was) is NaN here
                 placed = group.position(known, branch).poses
             misses[branch] = max(float(np.hypot(*(placed[k][0, :2] - ref.poses[k][:2]))
-                                       + ref.size * abs(_wrapped(placed[k][0, 2] - ref.poses[k][2])))
+                                       + ref.size * abs(wrap_angle(placed[k][0, 2] - ref.poses[k][2])))
                                  for k in group.links)
         chosen[i] = min(misses, key=lambda b: (not math.isfinite(misses[b]), misses[b]))
     return chosen
-
-
-def _has_modes(group) -> bool:
-    """Whether the group can be assembled in more than one way (its scheme needs a condition)."""
-    return len(group.branches) > 1 or getattr(group, "tracked", False)
 
 
 def _condition_points(structure: Structure, mech: Mechanism) -> tuple[dict[int, list[str]], dict[str, str]]:
@@ -491,7 +482,7 @@ def _condition_points(structure: Structure, mech: Mechanism) -> tuple[dict[int, 
     taken: set[str] = set()
     chosen, marks = {}, {}
     for i, group in enumerate(structure.groups):
-        if not _has_modes(group):
+        if not has_modes(group):
             continue
         own = {p for k in group.links for p in mech.links[k].points}
         chosen[i] = sorted(own - taken)
@@ -754,8 +745,7 @@ def _other_modes(group, known: dict[str, np.ndarray], mode: dict[str, np.ndarray
 def _pose_gap(a: dict[str, np.ndarray], b: dict[str, np.ndarray], size: float) -> float:
     """Distance between two sets of poses ``{link: (3,)}`` (the links of ``a``), m (angles weighted
     by ``size``, wrapped)."""
-    return math.sqrt(sum(float(np.sum((a[k][:2] - b[k][:2]) ** 2)) + (size * _wrapped(a[k][2] - b[k][2])) ** 2
-                         for k in a))
+    return float(poses_distance(a, b, a, size))
 
 
 def mode_conditions(mech: Mechanism, place: Placement, index: int,
