@@ -48,6 +48,7 @@ __all__ = [
     "NOT_CONVERGED",
     "RevoluteJoint",
     "PrismaticJoint",
+    "DrivenPrismaticJoint",
     "Group",
     "GroupPosition",
     "GroupSolution",
@@ -150,6 +151,7 @@ class RevoluteJoint:
     pa: tuple[float, float]
     pb: tuple[float, float]
     kind: ClassVar[str] = "R"
+    rows: ClassVar[int] = 2
 
     def local(self, link: str):
         """(local point on ``link``, other link, local point on the other link)."""
@@ -195,6 +197,7 @@ class PrismaticJoint:
     p: tuple[float, float]
     beta: float
     kind: ClassVar[str] = "P"
+    rows: ClassVar[int] = 2
 
     def frame(self, poses: Poses):
         """(u, n, ga, pb, d) in global coordinates, each ``(N, 2)``."""
@@ -251,6 +254,58 @@ class PrismaticJoint:
         return np.array([1.0, size])
 
 
+@dataclass(frozen=True)
+class DrivenPrismaticJoint(PrismaticJoint):
+    """A prismatic pair whose slide is driven: an actuator (a hydraulic cylinder) between two
+    links, its extension an input of the mechanism.
+
+    Three equations: the two of :class:`PrismaticJoint` and ``u . d - q = 0``, where ``q`` is the
+    x coordinate of the pose of the *driver*, a pseudo-link named ``driver`` (``"K.s"`` for the
+    pair K) whose pose ``(q, 0, 0)`` and analogs ``(q', 0, 0)``, ``(q'', 0, 0)`` the input sets.
+    The driver is a known link of the group that holds the pair, so the analogs and the
+    kinetostatics need nothing else: ``lambda[2]`` is the force the actuator exerts on the slider
+    along ``u`` (on the guide link, its opposite), the balancing force of the input (N), and the
+    load the group transmits to the driver is ``(-lambda[2], 0, 0)``.
+    """
+
+    driver: str = ""
+    kind: ClassVar[str] = "P"
+    rows: ClassVar[int] = 3
+
+    def residual(self, poses: Poses) -> np.ndarray:
+        u, _, _, _, d = self.frame(poses)
+        return np.concatenate([super().residual(poses), (dot(u, d) - poses[self.driver][:, 0])[:, None]], axis=1)
+
+    def jacobian(self, poses: Poses) -> dict[str, np.ndarray]:
+        u, n, ga, pb, d = self.frame(poses)
+        two = super().jacobian(poses)
+        N = len(u)
+        out = {}
+        # row 2: d(u . d) = -u . dr_a + (n . d - u . E ga) dtheta_a + u . dr_b + u . E pb dtheta_b
+        for link, rows_ab, along, turn in ((self.a, two[self.a], -u, dot(n, d) - dot(u, perp(ga))),
+                                           (self.b, two[self.b], u, dot(u, perp(pb)))):
+            block = np.zeros((N, 3, 3))
+            block[:, :2] = rows_ab
+            block[:, 2, :2] = along
+            block[:, 2, 2] = turn
+            out[link] = block
+        driver = np.zeros((N, 3, 3))
+        driver[:, 2, 0] = -1.0
+        out[self.driver] = driver
+        return out
+
+    def quadratic(self, poses: Poses, first: Poses) -> np.ndarray:
+        u, n, ga, pb, d = self.frame(poses)
+        ta, tb = first[self.a][:, 2:3], first[self.b][:, 2:3]
+        d1 = first[self.b][:, :2] + perp(pb) * tb - first[self.a][:, :2] - perp(ga) * ta
+        ta = ta[:, 0]
+        slide = dot(u, d) * ta**2 - 2 * ta * dot(n, d1) + dot(u, pb * tb**2 - ga * ta[:, None] ** 2)
+        return np.concatenate([super().quadratic(poses, first), slide[:, None]], axis=1)
+
+    def row_scale(self, size: float) -> np.ndarray:
+        return np.array([1.0, size, 1.0])
+
+
 Joint = RevoluteJoint | PrismaticJoint
 
 
@@ -303,7 +358,8 @@ class Group(ABC):
         self.links = tuple(links)
         self.joints = tuple(joints)
         self.size = float(size) if np.ndim(size) == 0 else np.asarray(size, dtype=float)
-        self.known_links = tuple(sorted(({j.a for j in joints} | {j.b for j in joints}) - set(links)))
+        touched = {j.a for j in joints} | {j.b for j in joints} | {getattr(j, "driver", j.a) for j in joints}
+        self.known_links = tuple(sorted(touched - set(links)))
 
     # -- binding -------------------------------------------------------------------------------
     @classmethod
@@ -374,17 +430,31 @@ class Group(ABC):
     def jacobians(self, poses: Poses) -> tuple[np.ndarray, dict[str, np.ndarray]]:
         """``Phi_q`` ``(N, m, m)`` for the group's links and ``Phi_k`` blocks ``(N, m, 3)``."""
         N = len(next(iter(poses.values())))
-        m = 2 * len(self.joints)
+        m = self.row_count
         col = {link: 3 * i for i, link in enumerate(self.links)}
         phi_q = np.zeros((N, m, 3 * len(self.links)))
         phi_k = {k: np.zeros((N, m, 3)) for k in self.known_links}
-        for r, joint in enumerate(self.joints):
+        for joint, rows in zip(self.joints, self.joint_rows):
             for link, block in joint.jacobian(poses).items():
                 if link in col:
-                    phi_q[:, 2 * r : 2 * r + 2, col[link] : col[link] + 3] += block
+                    phi_q[:, rows, col[link] : col[link] + 3] += block
                 else:
-                    phi_k[link][:, 2 * r : 2 * r + 2, :] += block
+                    phi_k[link][:, rows, :] += block
         return phi_q, phi_k
+
+    @property
+    def row_count(self) -> int:
+        """Number of constraint equations: two per pair, three for a driven prismatic pair."""
+        return sum(j.rows for j in self.joints)
+
+    @property
+    def joint_rows(self) -> list[slice]:
+        """The rows of each joint (in :attr:`joints` order) in the stacked constraint system."""
+        out, start = [], 0
+        for j in self.joints:
+            out.append(slice(start, start + j.rows))
+            start += j.rows
+        return out
 
     def contact_points(self, poses: Poses) -> np.ndarray:
         """Global points ``(N, n_joints, 2)`` where the group's pairs act, m.
@@ -445,7 +515,7 @@ class Group(ABC):
             c = 3 * i
             scaled[:, :, c + 2] += scaled[:, :, c] * rho[:, None, 1] - scaled[:, :, c + 1] * rho[:, None, 0]
             scaled[:, :, c + 2:c + 3] /= scale
-        angle_rows = [2 * r + 1 for r, j in enumerate(self.joints) if isinstance(j, PrismaticJoint)]
+        angle_rows = [rows.start + 1 for rows, j in zip(self.joint_rows, self.joints) if isinstance(j, PrismaticJoint)]
         scaled[:, angle_rows, :] *= scale
         det = np.linalg.det(scaled)
         norms = np.prod(np.linalg.norm(scaled, axis=2), axis=1)
@@ -540,6 +610,6 @@ class Group(ABC):
         q = np.concatenate([loads[link] for link in self.links], axis=1)
         lam = np.linalg.solve(np.transpose(phi_q, (0, 2, 1)), -q[..., None])[..., 0]
         lam[~ok] = np.nan
-        multipliers = {j.name: lam[:, 2 * r : 2 * r + 2] for r, j in enumerate(self.joints)}
+        multipliers = {j.name: lam[:, rows] for rows, j in zip(self.joint_rows, self.joints)}
         transmitted = {k: np.einsum("nji,nj->ni", phi_k[k], lam) for k in self.known_links}
         return multipliers, transmitted

@@ -145,7 +145,9 @@ class NewtonGroup(Group):
 
     @classmethod
     def _bind(cls, links, joints, known, size):
-        return cls(links, joints, size) if 3 * len(links) == 2 * len(joints) and len(links) >= 2 else None
+        rows = sum(j.rows for j in joints)
+        return cls(links, joints, size) if 3 * len(links) == rows and (len(links) >= 2 or rows > 2 * len(joints)) \
+            else None
 
     def __repr__(self) -> str:
         return f"{self.group_class}({','.join(sorted(self.links, key=_natural))})"
@@ -200,7 +202,7 @@ class NewtonGroup(Group):
         iteration left the finite numbers."""
         solved, _, _ = self._reached(poses, start)
         gaps = self.residual({**poses, **solved})
-        return np.max(np.hypot(gaps[:, 0::2], gaps[:, 1::2]), axis=1)
+        return np.max(np.stack([np.linalg.norm(gaps[:, rows], axis=1) for rows in self.joint_rows], axis=1), axis=1)
 
     def _reached(self, poses: Poses, start: Poses):
         """Newton's method from ``start``, or from the listed mode nearest to it: the poses

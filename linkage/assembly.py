@@ -66,6 +66,9 @@ class BranchPlan:
         does not exist; None for closed forms.
     periodic : bool
         Whether the track covers a whole turn (it then wraps around).
+    period : float or None
+        The period of the input coordinate (2 pi for an angle; None for a slide, whose change
+        points have no copies).
     """
 
     branch: int
@@ -74,6 +77,7 @@ class BranchPlan:
     swaps: np.ndarray
     track: tuple[np.ndarray, dict[str, np.ndarray]] | None = None
     periodic: bool = False
+    period: float | None = TWO_PI
 
     def start(self, phi: np.ndarray) -> dict[str, np.ndarray] | None:
         """Start poses ``{link: (N, 3)}`` at the input angles ``phi`` for a group solved by
@@ -104,6 +108,8 @@ class BranchPlan:
         if self.mode == "keep" or not self.swaps.any():
             return np.full(phi.shape, self.branch, dtype=int)
         points = np.sort(self.change_points[self.swaps])
+        if self.period is None:
+            return np.where(np.searchsorted(points, phi, side="right") % 2 == 0, self.branch, -self.branch)
         turns = np.floor(phi / TWO_PI)
         count = turns.astype(int) * len(points) + np.searchsorted(points, phi - turns * TWO_PI, side="right")
         return np.where(count % 2 == 0, self.branch, -self.branch)
@@ -114,6 +120,8 @@ class BranchPlan:
         phi = np.asarray(phi, dtype=float)
         low, high = np.minimum(phi[:-1], phi[1:]), np.maximum(phi[:-1], phi[1:])
         points = self.change_points[:, None]
+        if self.period is None:
+            return (low < points) & (points <= high)
         return np.floor((high - points) / TWO_PI) > np.floor((low - points) / TWO_PI)
 
     @property
@@ -205,10 +213,11 @@ def assembly_plans(mech: Mechanism) -> tuple[BranchPlan, ...]:
         if np.all(first.status == -1):
             _never_assembles(mech, group, poses)
         if len(group.branches) == 1:
-            plan = BranchPlan(1, "keep", np.empty(0), np.empty(0, bool))
+            plan = BranchPlan(1, "keep", np.empty(0), np.empty(0, bool), period=mech.coordinate.period)
         else:
             changes, swaps = _change_points(mech, structure, plans, i, phi, first.conditioning)
-            candidates = {m: BranchPlan(m, mode, changes, swaps) for m in group.branches}
+            candidates = {m: BranchPlan(m, mode, changes, swaps, period=mech.coordinate.period)
+                          for m in group.branches}
             if rule is not None and rule.phi is not None:
                 at = np.array([rule.phi])
                 chosen = _choose(mech, group, rule, candidates, _chain(mech, structure, plans, i, at), at)
@@ -355,7 +364,7 @@ def _traced_plan(mech, structure, plans, i, rule, poses, phi) -> BranchPlan:
             trial = {**poses, **trace.rows}
             score = _rule_score(mech, rule, trial)
             if rule.phi is not None:
-                near = int(np.argmin(np.abs((phi - rule.phi + np.pi) % TWO_PI - np.pi)))
+                near = int(np.argmin([_apart(x, rule.phi, mech) for x in phi]))
                 score = score[near:near + 1]
             with np.errstate(invalid="ignore"):
                 scores.append(int(np.sum(score > 1e-9 * mech.size)))
@@ -366,7 +375,8 @@ def _traced_plan(mech, structure, plans, i, rule, poses, phi) -> BranchPlan:
                 f"the assembly modes of {group!r} apart (two of its {len(traces)} modes satisfy it at "
                 f"{scores[order[0]]} of {len(phi)} input angles; choose a condition that only one mode meets)")
         chosen = int(order[0])
-    plan = BranchPlan(1, "keep", np.empty(0), np.empty(0, bool), _track(phi, traces[chosen], periodic), periodic)
+    plan = BranchPlan(1, "keep", np.empty(0), np.empty(0, bool), _track(phi, traces[chosen], periodic), periodic,
+                      mech.coordinate.period)
     changes = _traced_change_points(mech, group, known, known_at, plan, phi, traces[chosen].rows)
     return replace(plan, change_points=changes, swaps=np.zeros(len(changes), bool))
 
@@ -596,11 +606,11 @@ def _traced_change_points(mech, group, known, known_at, plan: BranchPlan, phi, r
 
     found: list[float] = []
     for x in _conditioning_minima(mech, phi, r, measure):
-        sides = placed(x + CROSSING_STEP * np.array([-1.0, 1.0])).status
+        sides = placed(x + crossing_step(mech) * np.array([-1.0, 1.0])).status
         if np.any((sides != OK) & (sides != SINGULAR)):
             continue    # the mode ends there: a limit position
-        angle = x % TWO_PI
-        if all(abs((angle - a + np.pi) % TWO_PI - np.pi) >= 1e-9 for a in found):
+        angle = _fold(x, mech)
+        if all(_apart(angle, a, mech) >= 1e-9 for a in found):
             found.append(angle)
     return np.sort(np.asarray(found, float))
 
@@ -634,13 +644,30 @@ def _change_points(mech, structure, plans, i, phi, r) -> tuple[np.ndarray, np.nd
         swap = _swaps(mech, structure, plans, i, x)
         if swap is None:
             continue  # one side cannot be assembled: a limit position, not a change point
-        angle = x % TWO_PI
-        if any(abs((angle - a + np.pi) % TWO_PI - np.pi) < 1e-9 for a in found):
+        angle = _fold(x, mech)
+        if any(_apart(angle, a, mech) < 1e-9 for a in found):
             continue
         found.append(angle)
         swaps.append(swap)
     order = np.argsort(found)
     return np.asarray(found, float)[order], np.asarray(swaps, bool)[order]
+
+
+def crossing_step(mech) -> float:
+    """:data:`CROSSING_STEP` in the first input's coordinate: rad, or that times the mechanism's
+    size for a slide (m)."""
+    return CROSSING_STEP if mech.coordinate.is_angle else CROSSING_STEP * mech.size
+
+
+def _fold(x: float, mech) -> float:
+    """A change point's coordinate: an angle folded into [0, 2 pi) (its copies a turn away are
+    the same point), a slide as it is."""
+    return x % TWO_PI if mech.coordinate.is_angle else float(x)
+
+
+def _apart(a: float, b: float, mech) -> float:
+    """How far apart two input coordinates are (angles: modulo a turn)."""
+    return abs((a - b + np.pi) % TWO_PI - np.pi) if mech.coordinate.is_angle else abs(a - b)
 
 
 def _conditioning_minima(mech, phi, r, measure) -> list[float]:
@@ -678,7 +705,7 @@ def _swaps(mech, structure, plans, i, angle) -> bool | None:
     """Whether branch +1 on the left of ``angle`` goes on as branch -1 on its right (None when
     one side cannot be assembled)."""
     group = structure.groups[i]
-    offsets = CROSSING_STEP * np.array([-3.0, -2.0, -1.0, 1.0, 2.0, 3.0])
+    offsets = crossing_step(mech) * np.array([-3.0, -2.0, -1.0, 1.0, 2.0, 3.0])
     poses = _chain(mech, structure, plans, i, angle + offsets)
     features = {}
     for m in group.branches:

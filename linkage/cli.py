@@ -350,12 +350,19 @@ def _add_columns_argument(p: argparse.ArgumentParser) -> None:
                         "CSV and JSON every column)")
 
 
+def _leading(columns) -> tuple[str, str]:
+    """The columns that lead a table: ``i`` and its position column (``phi_deg``, or ``s`` for a
+    slide input)."""
+    return ("i", "s") if "s" in columns else ("i", "phi_deg")
+
+
 def _emit(columns: dict, args, meta: dict, default_view: Callable[[dict], list[str]] | None = None,
-          always: Sequence[str] = ("i", "phi_deg")) -> None:
+          always: Sequence[str] | None = None) -> None:
     """Print a table in ``args.format``: the columns ``--columns`` asks for; without it, every
     column in CSV / JSON and ``default_view(columns)`` in the table for people (with one line
     saying how to see the others)."""
     units = units_of(columns)
+    always = _leading(columns) if always is None else always
     if args.columns is not None:
         try:
             columns = select_columns(columns, args.columns, always=always)
@@ -442,7 +449,7 @@ def _analyze_view(mech):
         groups += [triple(name) for name in columns if name.endswith(".s")]
         moving = [p for p in mech.point_names if mech.point_link(p) != mech.frame]
         groups += [[f"{p}.x", f"{p}.y"] for p in moving]
-        return _fit(columns, ("i", "phi_deg"), groups, skip_repeats=True)
+        return _fit(columns, _leading(columns), groups, skip_repeats=True)
     return view
 
 
@@ -453,6 +460,10 @@ def _sense_in_words(direction: int) -> str:
 def _start_line(mech, phi: np.ndarray, start, n: int, direction: int | None = None) -> str:
     """The ``# start:`` line of a table for people: position 1 and how phi_deg counts (along the
     table: in the direction of rotation over a turn, from A towards B over an input range)."""
+    if not mech.coordinate.is_angle:
+        s0, s1 = (round(float(v), 12) + 0.0 for v in (phi[0], phi[-1]))
+        return (f"s0 = {s0:.10g} m (start of the stroke); s runs to {s1:.10g} m, {n} steps over the stroke "
+                f"(input: the slide of pair '{mech.input_pair(mech.inputs[0])}')")
     sense = direction if direction is not None else (1 if len(phi) < 2 or phi[-1] >= phi[0] else -1)
     phi0 = round(float(np.degrees(phi[0])), 10) + 0.0  # no round-off noise such as 5e-14 deg for 0
     if start == "range":
@@ -497,7 +508,8 @@ def _say(results) -> None:
 def _add_speed_arguments(p: argparse.ArgumentParser, what: str) -> None:
     speed = p.add_mutually_exclusive_group()
     speed.add_argument("--omega", metavar="RAD_S", type=_real,
-                       help=f"{what}, rad/s, signed (negative: clockwise)")
+                       help=f"{what}, rad/s, signed (negative: clockwise); for a slide input its "
+                            "speed, m/s")
     speed.add_argument("--rpm", metavar="RPM", type=_real, help=f"{what}, rpm, signed")
 
 
@@ -526,7 +538,7 @@ def _add_forces(sub) -> None:
     _add_speed_arguments(p, "input angular velocity (default: the scheme's mean speed, else "
                             "none: a static analysis)")
     p.add_argument("--eps", metavar="RAD_S2", type=_real, default=0.0,
-                   help="input angular acceleration, rad/s^2 (default 0)")
+                   help="input angular acceleration, rad/s^2 (default 0); for a slide input, m/s^2")
     _add_columns_argument(p)
     _add_format_argument(p)
     p.set_defaults(handler=_cmd_forces)
@@ -536,9 +548,9 @@ def _forces_view(columns: dict) -> list[str]:
     """The default columns of ``linkage forces`` for people: the balancing moment, then the
     magnitude of every reaction, then their directions, as many as fit, in table order."""
     pairs = [name[:-2] for name in columns if name.endswith(".R")]
-    moments = [name for name in columns if name.startswith("balancing_moment")]
+    moments = [name for name in columns if name.startswith("balancing_")]
     groups = [moments] + [[f"{k}.R"] for k in pairs] + [[f"{k}.angle_deg"] for k in pairs]
-    shown = set(_fit(columns, ("i", "phi_deg"), groups))
+    shown = set(_fit(columns, _leading(columns), groups))
     return [name for name in columns if name in shown]
 
 
@@ -550,9 +562,10 @@ def _cmd_forces(args: argparse.Namespace) -> int:
     if args.format == "table":
         omega, phi = meta["omega"], results.motion.phi
         direction = declared_rotation(mech) if not omega else int(np.sign(omega))
-        speed = "none (static analysis)" if omega is None else f"{omega:.6g} rad/s"
+        unit = mech.coordinate.unit
+        speed = "none (static analysis)" if omega is None else f"{omega:.6g} {unit}/s"
         meta = {"scheme": mech.name, "start": _start_line(mech, phi, meta["start"], meta["positions"], direction),
-                "omega": speed, "eps": f"{args.eps:.6g} rad/s^2", "convention": meta["convention"],
+                "omega": speed, "eps": f"{args.eps:.6g} {unit}/s^2", "convention": meta["convention"],
                 "virtual_power_residual_max": meta["virtual_power_residual_max"]}
     _emit(results.columns, args, meta, _forces_view)
     return 0

@@ -787,11 +787,12 @@ def inertia_terms(motion: Motion, links: Iterable[str] | None = None) -> list[Lo
 
 
 def generalized_loads(motion: Motion, terms: Sequence[LoadTerm]) -> dict[str, np.ndarray]:
-    """Sum of terms per link as ``(Fx, Fy, moment about the link's local origin)`` ``(N, 3)``."""
+    """Sum of terms per link as ``(Fx, Fy, moment about the link's local origin)`` ``(N, 3)``
+    (zeros for the drivers of cylinder inputs too, which the groups load)."""
     from assur.base import cross
 
     n = len(motion.phi)
-    out = {k: np.zeros((n, 3)) for k in motion.mechanism.links}
+    out = {k: np.zeros((n, 3)) for k in [*motion.mechanism.links, *motion.structure.inputs]}
     for t in terms:
         out[t.link][:, :2] += t.force
         out[t.link][:, 2] += cross(motion.arm(t.link, t.local), t.force) + t.moment

@@ -21,7 +21,8 @@ from typing import Iterable, Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
-from assur.base import ANALOG_TOL, CANNOT_ASSEMBLE, OK, SINGULAR, global_point, point_analogs
+from assur.base import (ANALOG_TOL, CANNOT_ASSEMBLE, OK, SINGULAR, DrivenPrismaticJoint, global_point,
+                        point_analogs)
 from assur.rows import frame, xy
 
 from .assembly import assembly_branches, assembly_plans, place_group
@@ -30,7 +31,7 @@ from .model import Mechanism, Prismatic
 from .structure import Structure, decompose
 
 __all__ = ["Motion", "analyze", "input_sweep", "SWEEP", "structure_of", "assembly_branches", "BranchWarning",
-           "parse_quantity", "table_positions_deg", "angle_in_half_turn"]
+           "parse_quantity", "table_positions_deg", "angle_in_half_turn", "position_column"]
 
 
 #: input angles of :func:`input_sweep` (a turn in 360 steps, both ends included, or the input range)
@@ -207,8 +208,7 @@ class Motion:
         direction = self.direction if direction is None else direction
         if direction not in (1, -1):
             raise InputError(f"direction must be +1 or -1, got {direction!r}")
-        cols: dict[str, np.ndarray] = {"i": np.arange(1, len(self.phi) + 1),
-                                       "phi_deg": table_positions_deg(self.phi, direction)}
+        cols = self.position_columns(direction)
         primes = ("", "'", "''")
         for p in mech.point_names:
             if mech.point_link(p) in self.poses:
@@ -226,6 +226,13 @@ class Motion:
                     cols[q + prime] = angle_in_half_turn(arr) if q.endswith(".theta") and not prime else arr
         return cols
 
+    def position_columns(self, direction: int | None = None) -> dict[str, np.ndarray]:
+        """The leading columns of every table: ``i`` and the position column (:func:`position_column`)."""
+        direction = self.direction if direction is None else direction
+        coordinate = self.mechanism.coordinate
+        values = table_positions_deg(self.phi, direction) if coordinate.is_angle else self.phi.copy()
+        return {"i": np.arange(1, len(self.phi) + 1), position_column(self.mechanism): values}
+
     @property
     def direction(self) -> int:
         """The sense of the table: of the first step between the angles; for a single angle the
@@ -242,6 +249,13 @@ def _sense(phi: np.ndarray) -> int | None:
     steps = np.diff(phi)
     steps = steps[steps != 0]
     return (1 if steps[0] > 0 else -1) if len(steps) else None
+
+
+def position_column(mech: Mechanism) -> str:
+    """Name of a table's position column: ``"phi_deg"`` (the input angle travelled from the first
+    row, deg) when the first input is a crank, ``"s"`` (the input's slide, m, as in its pair's
+    ``K.s`` column) when it is a slide."""
+    return "phi_deg" if mech.coordinate.is_angle else "s"
 
 
 def table_positions_deg(phi: ArrayLike, direction: int | None = None) -> np.ndarray:
@@ -347,10 +361,10 @@ def analyze(
     run = _run_blocks(mech, structure, plans, list(group_ids), phi, order)
     for i in group_ids:
         group = structure.groups[i]
-        _check_continuity(group, run.signs[i], plans[i].branches(phi), run.solved[i], phi)
-        _check_change_points(group, plans[i], phi)
+        _check_continuity(group, run.signs[i], plans[i].branches(phi), run.solved[i], phi, mech.coordinate)
+        _check_change_points(group, plans[i], phi, mech.coordinate)
         if order >= 1:
-            _check_jumps(group, plans[i], run.poses, run.first, run.solved[i], phi)
+            _check_jumps(group, plans[i], run.poses, run.first, run.solved[i], phi, mech.coordinate)
     status, bad = run.status, run.status != OK
     if on_failure == "raise" and bad.any():
         raise _failure(mech, phi, run, structure, plans, list(group_ids))
@@ -503,14 +517,25 @@ def _input_state(mech: Mechanism, structure: Structure, phi: np.ndarray, poses: 
                     d[link] = np.empty((N, 3))
     zeros = np.zeros(N)
     frames = {mech.frame: (zeros, zeros, np.ones(N), zeros, zeros)}
-    for name, (theta, rate, accel) in input_angles(mech, structure, phi).items():
+    for name, (q, rate, accel) in input_angles(mech, structure, phi).items():
         joint = structure.input_joints[name]
+        out = poses[name]
+        if isinstance(joint, DrivenPrismaticJoint):    # a cylinder's driver: pose (s, 0, 0)
+            for values, d in ((q, poses), (rate, first), (accel, second)):
+                if d is not None:
+                    d[name][:, 0], d[name][:, 1:] = values, 0.0
+            frames[name] = (out[:, 0], zeros, np.ones(N), zeros, zeros)
+            continue
+        if joint.kind == "P":
+            _slider_state(joint, name, q, rate, accel, out, first and first[name], second and second[name])
+            c, s = np.cos(out[:, 2]), np.sin(out[:, 2])
+            frames[name] = (out[:, 0], out[:, 1], c, s, out[:, 2])
+            continue
         p_input, _, p_frame = joint.local(name)
         (px, py), (fx, fy) = xy(p_input), xy(p_frame)
-        c, s = np.cos(theta), np.sin(theta)
+        c, s = np.cos(q), np.sin(q)
         rx, ry = c * px - s * py, s * px + c * py
-        out = poses[name]
-        out[:, 0], out[:, 1], out[:, 2] = fx - rx, fy - ry, theta
+        out[:, 0], out[:, 1], out[:, 2] = fx - rx, fy - ry, q
         frames[name] = (out[:, 0], out[:, 1], c, s, out[:, 2])
         if first is not None:
             first[name][:, 0], first[name][:, 1], first[name][:, 2] = ry * rate, -rx * rate, rate
@@ -522,14 +547,41 @@ def _input_state(mech: Mechanism, structure: Structure, phi: np.ndarray, poses: 
     return frames
 
 
+def _slider_state(joint, link: str, s, rate, accel, pose, first, second) -> None:
+    """Pose and analogs ``(N, 3)`` of an input ``link`` driven along a frame guide by the slide
+    ``s`` of its prismatic ``joint`` (rate ``ds/dphi`` and ``d2s/dphi2``): the slide ``s = u . d``
+    of :class:`assur.base.PrismaticJoint` solved for the link's pose, whether the guide is on the
+    frame (the link is the slider) or on the link (the frame's point slides in the link's guide)."""
+    if joint.b == link:             # guide on the frame: r = g + s u - Rot(beta) p
+        theta, sign = joint.beta, 1.0
+        u = np.asarray(joint.u, float)
+        start = np.asarray(joint.g, float) - _turned(theta, joint.p)
+    else:                           # guide on the link: r = p - Rot(-beta) g - s u
+        theta, sign = -joint.beta, -1.0
+        u = _turned(theta, joint.u)
+        start = np.asarray(joint.p, float) - _turned(theta, joint.g)
+    along = sign * np.asarray(s, float)
+    pose[:, 0], pose[:, 1], pose[:, 2] = start[0] + along * u[0], start[1] + along * u[1], theta
+    for analogs, value in ((first, rate), (second, accel)):
+        if analogs is not None:
+            analogs[:, 0], analogs[:, 1], analogs[:, 2] = sign * value * u[0], sign * value * u[1], 0.0
+
+
+def _turned(theta: float, p) -> np.ndarray:
+    """``Rot(theta) p`` for one angle and one local vector ``(2,)``."""
+    c, s = np.cos(theta), np.sin(theta)
+    return np.array([c * p[0] - s * p[1], s * p[0] + c * p[1]])
+
+
 def input_angles(mech: Mechanism, structure: Structure, phi: np.ndarray) -> dict[str, tuple]:
-    """Each input link's angle and its first and second analogs ``(theta, dtheta/dphi,
-    d2theta/dphi2)``, ``(N,)`` each, at the first input's angles ``phi`` (the first input: ``phi``,
-    1, 0; further inputs: their :class:`~linkage.input_laws.InputLaw`)."""
+    """Each input link's coordinate (its angle, rad, or its slide, m) and the coordinate's first and
+    second analogs ``(q, dq/dphi, d2q/dphi2)``, ``(N,)`` each, at the first input's coordinates
+    ``phi`` (the first input: ``phi``, 1, 0; further inputs: their
+    :class:`~linkage.input_laws.InputLaw`, declared under the input's name)."""
     ones, zeros = np.ones(len(phi)), np.zeros(len(phi))
     out = {}
-    for k, name in enumerate(structure.inputs):
-        out[name] = (phi, ones, zeros) if k == 0 else mech.input_laws[name].angles(phi)
+    for k, (name, declared) in enumerate(zip(structure.inputs, mech.inputs)):
+        out[name] = (phi, ones, zeros) if k == 0 else mech.input_laws[declared].angles(phi)
     return out
 
 
@@ -552,11 +604,11 @@ def _failure(mech: Mechanism, phi: np.ndarray, run: _Run, structure: Structure, 
 
     status, conditioning = run.status, run.conditioning
     parts = []
+    coordinate = mech.coordinate
     for code, what in ((CANNOT_ASSEMBLE, "cannot be assembled"), (SINGULAR, "is singular")):
-        angles = np.degrees(phi[status == code])
-        if len(angles):
-            shown = ", ".join(f"{a:.6g}" for a in angles[:20]) + (" ..." if len(angles) > 20 else "")
-            parts.append(f"{what} at {len(angles)} input angle(s) (deg): {shown}")
+        at = phi[status == code]
+        if len(at):
+            parts.append(f"{what} at {len(at)} {coordinate.describe(at)}")
     unconverged = []
     for i in group_ids:
         rows = np.flatnonzero(run.solved[i] == NOT_CONVERGED)
@@ -566,11 +618,12 @@ def _failure(mech: Mechanism, phi: np.ndarray, run: _Run, structure: Structure, 
         known = {k: run.poses[k][rows] for k in group.known_links}
         residual = group.closure(known, plans[i].start(phi[rows]))
         size = float(np.max(group.size))
-        angles = np.degrees(phi[rows])
+        angles = coordinate.shown(phi[rows])
         unconverged.append((repr(group), angles, residual, size))
         shown = ", ".join(f"{a:.6g} ({r:.3g} m, {r / size:.3g})" for a, r in zip(angles[:20], residual[:20]))
-        parts.append(f"is not solved at {len(rows)} input angle(s) where Newton's method did not converge for "
-                     f"group {group!r} (deg, closure residual m, relative to the size {size:.6g} m): {shown}"
+        parts.append(f"is not solved at {len(rows)} input {coordinate.kind}(s) where Newton's method did not "
+                     f"converge for group {group!r} ({coordinate.shown_unit}, closure residual m, relative to the "
+                     f"size {size:.6g} m): {shown}"
                      + (" ..." if len(rows) > 20 else ""))
     singular = status == SINGULAR
     if singular.any():
@@ -582,27 +635,27 @@ def _failure(mech: Mechanism, phi: np.ndarray, run: _Run, structure: Structure, 
                      "see Motion.conditioning)")
     message = (f"mechanism '{mech.name}' " + "; ".join(parts)
                + " (use on_failure='mask' to get a per-position status instead)")
-    bad = np.degrees(phi[status != OK])
+    bad = coordinate.shown(phi[status != OK])
     if unconverged:
         group, angles, residual, size = unconverged[0]
         return ConvergenceError(message, bad, group, angles, residual, size)
     return AssemblyError(message, bad)
 
 
-def _check_continuity(group, sign: np.ndarray, branches: np.ndarray, solved: np.ndarray, phi) -> None:
+def _check_continuity(group, sign: np.ndarray, branches: np.ndarray, solved: np.ndarray, phi, coordinate) -> None:
     """Warn when the group's Jacobian determinant changes sign (relative to the branch in use)
     between positions: the group passes a singular position between analysed angles."""
     ok = solved == OK
     signs = (sign * branches)[ok]
     if len(signs) and np.any(signs != signs[0]):
-        changed = np.degrees(phi[ok][signs != signs[0]])
+        changed = coordinate.shown(phi[ok][signs != signs[0]])
         warnings.warn(
-            f"group {group!r} is in another assembly mode at input angles (deg) "
+            f"group {group!r} is in another assembly mode at input {coordinate.kind}s ({coordinate.shown_unit}) "
             f"{np.array2string(changed[:10], precision=4)}: it passes a singular position between "
             "analysed angles", BranchWarning, stacklevel=3)
 
 
-def _check_change_points(group, plan, phi) -> None:
+def _check_change_points(group, plan, phi, coordinate) -> None:
     """Warn when the analysed angles pass a change point that the group keeps its branch through
     (for a group solved by Newton's method: that its traced assembly mode passes), or when a
     followed motion needs two turns to repeat and a whole turn is analysed."""
@@ -610,16 +663,18 @@ def _check_change_points(group, plan, phi) -> None:
         return
     if plan.mode == "keep":
         passed = plan.change_points[plan.crossed(phi).any(axis=1)]
-        shown = ", ".join(f"{round(float(np.degrees(c)), 6) % 360 + 0.0:g}" for c in passed)
+        shown = ", ".join(f"{round(float(coordinate.shown(c)), 6) % 360 + 0.0:g}" if coordinate.is_angle
+                          else f"{float(c):.6g}" for c in passed)
+        where = f"input {coordinate.kind}(s) {shown} {coordinate.shown_unit}"
         if len(passed) and plan.track is not None:      # a group solved by Newton's method
             warnings.warn(
-                f"group {group!r} passes a change point at input angle(s) {shown} deg, where its traced "
+                f"group {group!r} passes a change point at {where}, where its traced "
                 "assembly mode meets another: the motion may go on in either there (the position at it "
                 "is singular); past it the group takes the mode its plan traced, the one nearest to "
                 "the motion before it", BranchWarning, stacklevel=3)
         elif len(passed):
             warnings.warn(
-                f"group {group!r} passes a change point at input angle(s) {shown} deg, where its two "
+                f"group {group!r} passes a change point at {where}, where its two "
                 "assembly modes meet; keeping its declared branch it switches assembly mode there "
                 "(declare mode = \"follow\" in its assembly condition to follow the motion through "
                 "it)", BranchWarning, stacklevel=3)
@@ -629,12 +684,13 @@ def _check_change_points(group, plan, phi) -> None:
             "repeats its motion only after two turns of the input", BranchWarning, stacklevel=3)
 
 
-#: largest step between analysed angles (rad) over which :func:`_check_jumps` compares the motion
-#: with its analogs (beyond it the trapezoid rule is too coarse to tell a jump from a fast motion)
+#: largest step between analysed angles (rad; for a slide input, this times the mechanism's size,
+#: m) over which :func:`_check_jumps` compares the motion with its analogs (beyond it the
+#: trapezoid rule is too coarse to tell a jump from a fast motion)
 JUMP_CHECK_STEP = np.pi / 18
 
 
-def _check_jumps(group, plan, poses, first, status, phi) -> None:
+def _check_jumps(group, plan, poses, first, status, phi, coordinate) -> None:
     """Warn where a group moves between two analysed angles (at most 10 deg apart) by more than
     its first analogs allow: the displacement of points fixed in its links differs from the
     trapezoid rule on their analogs by more than half of either (a change point or a singular
@@ -643,7 +699,8 @@ def _check_jumps(group, plan, poses, first, status, phi) -> None:
     if len(phi) < 2:
         return
     dphi = np.diff(phi)
-    pairs = (status[:-1] == OK) & (status[1:] == OK) & (np.abs(dphi) <= JUMP_CHECK_STEP) & (dphi != 0)
+    largest = JUMP_CHECK_STEP * (1.0 if plan.period is not None else float(np.max(group.size)))
+    pairs = (status[:-1] == OK) & (status[1:] == OK) & (np.abs(dphi) <= largest) & (dphi != 0)
     if plan.mode == "keep" and len(plan.change_points):        # passed change points: reported
         pairs &= ~plan.crossed(phi).any(axis=0)
     if not pairs.any():
@@ -654,9 +711,10 @@ def _check_jumps(group, plan, poses, first, status, phi) -> None:
     bad = jump_steps(group, poses, first, pairs, dphi, scale)
     if bad.any():
         k = np.flatnonzero(bad)
-        shown = ", ".join(f"{np.degrees(phi[j]):.6g}..{np.degrees(phi[j + 1]):.6g}" for j in k[:5])
+        values = coordinate.shown(phi)
+        shown = ", ".join(f"{values[j]:.6g}..{values[j + 1]:.6g}" for j in k[:5])
         warnings.warn(
-            f"group {group!r} moves between the input angles {shown} deg more than its analogs "
+            f"group {group!r} moves between the input {coordinate.kind}s {shown} {coordinate.shown_unit} more than its analogs "
             "allow: it passes a change point or a singular position between them (analyse finer "
             "angles there)", BranchWarning, stacklevel=3)
 

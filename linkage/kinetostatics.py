@@ -28,12 +28,12 @@ from typing import Iterable
 import numpy as np
 from numpy.typing import ArrayLike
 
-from assur.base import OK, PrismaticJoint, point_analogs
+from assur.base import OK, DrivenPrismaticJoint, PrismaticJoint, point_analogs
 from assur.rows import rows_of
 
 from .errors import InputError
 from .forces import LoadTerm, Loads, evaluate_loads, generalized_loads, inertia_terms, loads_of
-from .kinematics import Motion, angle_in_half_turn, table_positions_deg
+from .kinematics import Motion, angle_in_half_turn
 
 __all__ = ["Reactions", "reactions_under", "solve_reactions", "virtual_power_residual"]
 
@@ -102,17 +102,18 @@ class Reactions:
         return np.degrees(angle_in_half_turn(np.arctan2(f[:, 1], f[:, 0])))
 
     def columns(self, full: bool = False, direction: int | None = None) -> dict[str, np.ndarray]:
-        """Table: ``i``, ``phi_deg`` (as in :meth:`Motion.columns`), ``balancing_moment`` (N m; with
-        several inputs, the first's, and ``balancing_moment.K`` for each further input link K), per pair ``K.R`` (magnitude of ``R[a, b]``, N) and ``K.angle_deg`` (its direction, deg CCW
+        """Table: ``i``, ``phi_deg`` (as in :meth:`Motion.columns`; ``s`` for a slide input),
+        ``balancing_moment`` (N m; ``balancing_force``, N, for a slide input; with several inputs,
+        the first's, and ``balancing_moment.K`` or ``balancing_force.K`` for each further input K), per pair ``K.R`` (magnitude of ``R[a, b]``, N) and ``K.angle_deg`` (its direction, deg CCW
         from +x in (-180, 180]); with ``full`` also ``K.Rx``, ``K.Ry`` (N) and, for
         prismatic pairs, ``K.M`` (N m, the moment of the slider on the guide about the slider's
         point). Pairs in the order of their names. ``direction``: see :meth:`Motion.columns`."""
-        direction = self.motion.direction if direction is None else direction
-        cols = {"i": np.arange(1, len(self.motion.phi) + 1),
-                "phi_deg": table_positions_deg(self.motion.phi, direction),
-                "balancing_moment": self.balancing_moment}
+        cols = self.motion.position_columns(direction)
+        load = self.motion.mechanism.coordinate.load
+        cols[f"balancing_{load}"] = self.balancing_moment
         for link in self.motion.structure.inputs[1:]:
-            cols[f"balancing_moment.{link}"] = self.balancing_moments.get(link, np.full(len(self.motion.phi), np.nan))
+            kind = "moment" if self.motion.mechanism.input_kind(link) == "angle" else "force"
+            cols[f"balancing_{kind}.{link}"] = self.balancing_moments.get(link, np.full(len(self.motion.phi), np.nan))
         for name in sorted(self.multipliers):
             cols[f"{name}.R"] = self.magnitude(name)
             cols[f"{name}.angle_deg"] = self.direction_deg(name)
@@ -216,18 +217,37 @@ def reactions_under(motion: Motion, terms: list[LoadTerm], pairs: Iterable[str] 
         return Reactions(motion, multipliers, np.full(len(motion.phi), np.nan), terms, notes)
     balancing = {}
     for link in structure.inputs:
-        # each input link's equilibrium: its pin carries the force, its M_b what is left of the moment
+        # each input link's equilibrium: the drive takes the load's part along the link's motion
+        # (a moment for a crank, a force along the guide for a slider), its pair what is left
         joint = structure.input_joints[link]
-        pin = rows_of(joint, {k: motion.frame(k) for k in (joint.a, joint.b)})
+        if isinstance(joint, DrivenPrismaticJoint):
+            # a cylinder: its group transmitted (-lambda[2], 0, 0) to the driver; lambda[2] balances
+            balancing[link] = -applied[link][:, 0]
+            continue
+        rows = rows_of(joint, {k: motion.frame(k) for k in (joint.a, joint.b)})
+        motion_per_unit, drive = input_freedom(joint, link, rows)
         load = -applied[link]
-        force = pin.multipliers(link, (load[:, 0], load[:, 1], load[:, 2]))
-        multipliers[joint.name] = np.column_stack(force)
-        balancing[link] = load[:, 2] - pin.constraint_load(link, force)[2]
+        balancing[link] = sum(load[:, c] * motion_per_unit[c] for c in range(3))
+        rest = tuple(load[:, c] - balancing[link] * drive[c] for c in range(3))
+        multipliers[joint.name] = np.column_stack(rows.multipliers(link, rest))
     bad = ~valid
     if bad.any():
         balancing = {k: np.where(bad, np.nan, v) for k, v in balancing.items()}
         multipliers = {k: np.where(bad[:, None], np.nan, v) for k, v in multipliers.items()}
     return Reactions(motion, multipliers, balancing[structure.inputs[0]], terms, notes, balancing)
+
+
+def input_freedom(joint, link: str, rows) -> tuple[tuple, tuple]:
+    """The motion an input ``link`` has in its ``joint`` with the frame, per unit of its coordinate
+    (``(vx, vy, w)``: a turn about the pin for a crank, a slide along the guide for a slider), and
+    the generalized load ``(Fx, Fy, M)`` of a unit drive (a unit moment, or a unit force along the
+    slide through the link's origin) -- the drive whose value is the balancing moment or force.
+    ``rows``: :func:`assur.rows.rows_of` of the joint at the motion's frames."""
+    vx, vy, w = rows.null(link)
+    if joint.kind == "R":
+        return (vx, vy, w), (0.0, 0.0, 1.0)
+    sign = 1.0 if link == joint.b else -1.0        # guide on the frame: the link slides along +u
+    return (sign * vx, sign * vy, 0.0), (sign * vx, sign * vy, 0.0)
 
 
 def virtual_power_residual(reactions: Reactions) -> np.ndarray:

@@ -42,6 +42,7 @@ __all__ = [
     "Output",
     "Mechanism",
     "MechanismBuilder",
+    "InputCoordinate",
     "MAX_MAGNITUDE",
     "MIN_MAGNITUDE",
     "MAX_ANGLE_DEG",
@@ -186,6 +187,62 @@ class Output:
     start: str = "max"
 
 
+@dataclass(frozen=True)
+class InputCoordinate:
+    """The generalized coordinate of an input: a crank's angle or a slide.
+
+    ``kind`` is ``"angle"`` (a crank pinned to the frame: rad, shown in deg, periodic over a turn)
+    or ``"slide"`` (a slider driven along a frame guide, or a cylinder's extension between two
+    links: m, shown in m, not periodic, analysed over a declared stroke). The analogs of every
+    quantity are derivatives with respect to the first input's coordinate (per rad or per m), and
+    an input's balancing load is a moment (N m) or a force (N) accordingly (docs/inputs.md).
+    """
+
+    kind: str = "angle"
+
+    @property
+    def is_angle(self) -> bool:
+        return self.kind == "angle"
+
+    @property
+    def symbol(self) -> str:
+        """``"phi"`` or ``"s"``."""
+        return "phi" if self.is_angle else "s"
+
+    @property
+    def unit(self) -> str:
+        """SI unit of the coordinate: ``"rad"`` or ``"m"``."""
+        return "rad" if self.is_angle else "m"
+
+    @property
+    def shown_unit(self) -> str:
+        """Unit of the coordinate in tables and messages: ``"deg"`` or ``"m"``."""
+        return "deg" if self.is_angle else "m"
+
+    @property
+    def period(self) -> float | None:
+        """``2 pi`` for an angle, None for a slide."""
+        return 2 * math.pi if self.is_angle else None
+
+    @property
+    def load(self) -> str:
+        """What balances the input: ``"moment"`` (N m) or ``"force"`` (N)."""
+        return "moment" if self.is_angle else "force"
+
+    def shown(self, values):
+        """Values of the coordinate in the unit of tables and messages (deg or m)."""
+        import numpy as np
+
+        return np.degrees(values) if self.is_angle else np.asarray(values, dtype=float)
+
+    def describe(self, values, limit: int = 20) -> str:
+        """``"input angle(s) (deg): 10, 20"`` or ``"input slide(s) (m): 0.1, 0.2"`` for values in
+        the SI unit (at most ``limit`` shown)."""
+        values = list(self.shown(values))
+        shown = ", ".join(f"{v:.6g}" for v in values[:limit]) + (" ..." if len(values) > limit else "")
+        return f"input {self.kind}(s) ({self.shown_unit}): {shown}"
+
+
 @dataclass(frozen=True, eq=True)
 class Mechanism:
     """A planar mechanism with lower pairs.
@@ -199,6 +256,12 @@ class Mechanism:
 
     ``input_laws`` maps each input link after the first to the law its angle follows as a function
     of the first input's angle ``phi`` (:class:`~linkage.input_laws.InputLaw`; mobility W > 1).
+
+    An input is named by a link or by a pair (:meth:`input_pair`): a link pinned to the frame is
+    a crank (its angle is the coordinate); a link in a prismatic pair with the frame, or a
+    prismatic pair itself, is driven by its slide (m; a pair between two moving links is a
+    cylinder's extension). The first input's coordinate (:attr:`coordinate`) is what ``phi`` of
+    every analysis holds (rad or m); a slide needs ``input_range``, the stroke (m).
     """
 
     name: str
@@ -242,6 +305,29 @@ class Mechanism:
                 for q in pts[i + 1 :]:
                     size = max(size, math.dist(p, q))
         return size if size > 0 else 1.0
+
+    def input_pair(self, name: str) -> str | None:
+        """The pair that drives the input ``name``: the pair itself when ``name`` is a pair; for a
+        link, its revolute pair with the frame (the first by name), else its prismatic pair with
+        the frame; None when there is none."""
+        if name in self.pairs:
+            return name
+        frame_pairs = sorted(k for k, p in self.pairs.items() if set(p.links) == {name, self.frame})
+        for kind in (Revolute, Prismatic):
+            found = [k for k in frame_pairs if isinstance(self.pairs[k], kind)]
+            if found:
+                return found[0]
+        return None
+
+    def input_kind(self, name: str) -> str:
+        """``"angle"`` for an input driven by a revolute pair, ``"slide"`` for a prismatic one."""
+        pair = self.pairs.get(self.input_pair(name) or "")
+        return "slide" if isinstance(pair, Prismatic) else "angle"
+
+    @property
+    def coordinate(self) -> InputCoordinate:
+        """The first input's coordinate (an angle or a slide): what ``phi`` holds."""
+        return InputCoordinate(self.input_kind(self.inputs[0]) if self.inputs else "angle")
 
     def point_link(self, point: str) -> str:
         """Name of the link that reports the position of ``point`` (frame first, then by name)."""
@@ -452,6 +538,8 @@ class MechanismBuilder:
         self._assembly: list[Assembly] = []
         self._output: Output | None = None
         self._range: tuple[float, float] | None = None
+        self._range_in_degrees = False
+        self._range_given: str | None = None
         self._problems: list[str] = []
         self._rejected: set[str] = set()  # links and pairs refused (reported already)
         self._unplaced: dict[str, set[str]] = {}  # link -> its points and guides refused
@@ -723,26 +811,23 @@ class MechanismBuilder:
         self._output = Output(quantity, start)
         return self
 
-    def input_range(self, start: float, end: float) -> "MechanismBuilder":
-        """Analyse the mechanism over the input angles from ``start`` to ``end`` (rad) instead of
-        a full turn: for an input that does not turn fully (a rocker input, a tangent mechanism).
+    def input_range(self, start: float, end: float, *, degrees: bool = False,
+                    given: str | None = None) -> "MechanismBuilder":
+        """Analyse the mechanism over the first input's coordinate from ``start`` to ``end``
+        instead of a full turn: angles (rad) for an input that does not turn fully (a rocker
+        input, a tangent mechanism; a span of more than 0 and less than a turn), or the stroke (m)
+        of a slide input (which needs one).
 
-        Tables run from ``start`` to ``end`` (``end < start`` for an input that turns clockwise);
-        the two must differ by more than 0 and less than a full turn.
+        Tables run from ``start`` to ``end`` (``end < start`` for an input that turns clockwise or
+        slides backwards). ``degrees``: the range was given in degrees (converted to rad), which
+        only an input angle accepts; ``given``: how it was written (named in messages).
         """
-        where = "input range"
-        ok = [check_number(v, where, name, self._problems, "angle", "rad") for v, name in
+        ok = [check_number(v, "input range", name, self._problems, "real") for v, name in
               ((start, "start"), (end, "end"))]
-        if None in ok:
-            return self
-        a, b = ok
-        if not 0 < abs(b - a) < 2 * math.pi:
-            self._problems.append(
-                f"{where}: the range [{math.degrees(a):.10g}, {math.degrees(b):.10g}] deg must span more than 0 "
-                f"and less than 360 deg (a full turn needs no range; choose position 1 with start_deg), "
-                f"got a span of {abs(math.degrees(b - a)):.10g} deg")
-            return self
-        self._range = (a, b)
+        if None not in ok:
+            self._range = (ok[0], ok[1])
+            self._range_in_degrees = degrees
+            self._range_given = given
         return self
 
     def build(self, **extra: Any) -> Mechanism:
@@ -766,6 +851,11 @@ class MechanismBuilder:
         for name in self._incomplete:
             refused[name] = _EVERY_NAME
         problems = self._problems + validate(mech, self._rejected, refused, inputs_refused=self._inputs_refused)
+        if self._range_in_degrees and mech.inputs and not mech.coordinate.is_angle:
+            problems.append(f"range_deg: input '{mech.inputs[0]}' is a slide, whose stroke is in m: give "
+                            "range = [s_start, s_end] (m) instead")
+        elif not self._inputs_refused:
+            problems.extend(_range_problems(mech, self._range_given or "input range"))
         if problems:
             raise SchemeError(problems)
         return mech
@@ -840,14 +930,7 @@ def validate(mech: Mechanism, rejected=frozenset(), unplaced: Mapping[str, set] 
     if len(set(mech.inputs)) != len(mech.inputs):
         p.append(f"input links declared twice: {list(mech.inputs)}")
     for name in mech.inputs:
-        if name not in links:
-            if name not in rejected:
-                p.append(f"input link '{name}' is not a declared link")
-        elif name == mech.frame:
-            p.append(f"input link '{name}' is the frame")
-        elif not rejected and not any(isinstance(pr, Revolute) and set(pr.links) == {name, mech.frame}
-                                      for pr in mech.pairs.values()):
-            p.append(f"input link '{name}' is not pinned to the frame '{mech.frame}' by a revolute pair")
+        p.extend(_input_problems(mech, name, rejected))
     p.extend(_law_problems(mech))
     known_points = {q for lk in links.values() for q in lk.points}
     refused_points = {q for names in unplaced.values() for q in names}
@@ -858,6 +941,49 @@ def validate(mech: Mechanism, rejected=frozenset(), unplaced: Mapping[str, set] 
     if mech.output is not None:
         p.extend(_output_problems(mech, refused=set(rejected) | refused_points))
     return p
+
+
+def _input_problems(mech: Mechanism, name: str, rejected=frozenset()) -> list[str]:
+    """Problems of one declared input: a link pinned to the frame or in a prismatic pair with it,
+    or a pair (a revolute pair with the frame, or any prismatic pair)."""
+    if name in mech.pairs:
+        pair = mech.pairs[name]
+        if isinstance(pair, Revolute) and mech.frame not in pair.links:
+            return [f"input pair '{name}' is a revolute pair between two moving links {list(pair.links)}: an input "
+                    "pair is a revolute pair with the frame (a crank) or a prismatic pair (a slide)"]
+        return []
+    if name not in mech.links:
+        return [] if name in rejected else [f"input link '{name}' is not a declared link (nor a pair)"]
+    if name == mech.frame:
+        return [f"input link '{name}' is the frame"]
+    if not rejected and mech.input_pair(name) is None:
+        return [f"input link '{name}' is not pinned to the frame '{mech.frame}' by a revolute pair nor slides on it "
+                "by a prismatic pair"]
+    return []
+
+
+def _range_problems(mech: Mechanism, given: str = "input range") -> list[str]:
+    """Problems of the input range for the first input's coordinate: an angle's range spans more
+    than 0 and less than a turn; a slide needs a stroke of nonzero length."""
+    if not mech.inputs:
+        return []
+    span = mech.input_range
+    first = mech.inputs[0]
+    if mech.coordinate.is_angle:
+        if span is not None and not 0 < abs(span[1] - span[0]) < 2 * math.pi:
+            a, b = (math.degrees(v) for v in span)
+            return [f"{given}: the range [{a:.10g}, {b:.10g}] deg must span more than 0 and less than 360 deg "
+                    f"(a full turn needs no range; choose position 1 with start_deg), got a span of "
+                    f"{abs(b - a):.10g} deg"]
+        return []
+    if span is None:
+        return [f"input '{first}' is a slide (prismatic pair '{mech.input_pair(first)}'): declare its stroke, "
+                "range = [s_start, s_end] in m (the slide of the pair, as in the table's column "
+                f"'{mech.input_pair(first)}.s')"]
+    if not span[1] != span[0] or not all(abs(v) <= MAX_MAGNITUDE for v in span):
+        return [f"{given}: the stroke [{span[0]:.10g}, {span[1]:.10g}] m of slide input '{first}' must have a "
+                f"nonzero length and ends within {MAX_MAGNITUDE:g} m"]
+    return []
 
 
 def _law_problems(mech: Mechanism) -> list[str]:
@@ -876,6 +1002,11 @@ def _law_problems(mech: Mechanism) -> list[str]:
             problems.append(f"input link '{link}' needs a law (input_laws.{link}: ratio and phase_deg, or table_deg): "
                             f"how its angle follows the first input's ('{first}')")
     for link, law in mech.input_laws.items():
+        if law.table is not None and link in further and not mech.coordinate.is_angle:
+            problems.append(f"input law of link '{link}': a table law follows the first input's angle, but the "
+                            f"first input '{first}' is a slide: give a ratio and a phase (the further input's "
+                            "coordinate = ratio * s + phase)")
+            continue
         if law.domain is None or link not in further:
             continue
         low, high = law.domain

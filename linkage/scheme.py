@@ -20,8 +20,8 @@ from pathlib import Path
 from typing import Any, Callable, Mapping
 
 from .errors import LinkageError, SchemeError
-from .model import (MAX_ANGLE_DEG, Mechanism, MechanismBuilder, Prismatic, Revolute, _angle, _is_number,
-                    unknown_keys)
+from .model import (MAX_ANGLE_DEG, MAX_MAGNITUDE, Mechanism, MechanismBuilder, Prismatic, Revolute, _angle,
+                    _is_number, unknown_keys)
 
 __all__ = ["load", "loads", "dumps", "save", "shipped_schemes", "scheme_path", "section_of",
            "register_section", "SECTION_PARSERS"]
@@ -256,7 +256,8 @@ def from_dict(data: Mapping[str, Any], default_name: str = "mechanism") -> Mecha
             problems.append(f"output: expected \"P.x\" or {{quantity, start}}, got {output!r}")
     span = _input_range(data, problems)
     if span is not None:
-        builder.input_range(*span)
+        key = "range_deg" if "range_deg" in data else "range"
+        builder.input_range(*span, degrees=key == "range_deg", given=f"{key} = {data[key]!r}")
     try:
         mech = builder.build(**extra_sections)
     except SchemeError as exc:
@@ -284,28 +285,24 @@ def from_dict(data: Mapping[str, Any], default_name: str = "mechanism") -> Mecha
 
 
 def _input_range(data: Mapping[str, Any], problems: list[str]) -> tuple[float, float] | None:
-    """The input range ``range_deg = [a, b]`` (or ``range``, rad) in rad; None when absent or
-    refused (with the problem, naming the key and the value)."""
+    """The input range ``range_deg = [a, b]`` (or ``range``: rad for an input angle, m for a
+    slide's stroke) in rad or m; None when absent or refused (with the problem, naming the key and
+    the value). Its span is checked against the input's kind when the mechanism is built."""
     if "range" in data and "range_deg" in data:
-        problems.append("give either 'range' (rad) or 'range_deg' (deg), not both")
+        problems.append("give either 'range' (rad) or 'range_deg' (deg), not both ('range' is in m for a slide "
+                        "input)")
         return None
     key = "range_deg" if "range_deg" in data else "range" if "range" in data else None
     if key is None:
         return None
     raw = data[key]
-    unit, largest = ("deg", MAX_ANGLE_DEG) if key == "range_deg" else ("rad", math.radians(MAX_ANGLE_DEG))
+    largest = MAX_ANGLE_DEG if key == "range_deg" else MAX_MAGNITUDE
+    unit = "deg" if key == "range_deg" else "rad (m for a slide input)"
     if not (isinstance(raw, list) and len(raw) == 2 and all(_is_number(v) and abs(v) <= largest for v in raw)):
-        problems.append(f"{key}: expected [a, b], two input angles in {unit} with |x| <= {largest:.6g} "
-                        f"(the input turns from a to b), got {raw!r}")
+        problems.append(f"{key}: expected [a, b], two input coordinates in {unit} with |x| <= {largest:.6g} "
+                        f"(the input goes from a to b), got {raw!r}")
         return None
-    a, b = (math.radians(v) for v in raw) if key == "range_deg" else (float(v) for v in raw)
-    span = abs(math.degrees(b - a))
-    if not 0 < span < 360:
-        problems.append(f"{key} = {raw!r}: the range must span more than 0 and less than 360 deg, got "
-                        f"{span:.10g} deg (for a full turn leave the range out and choose position 1 with "
-                        "[dynamics] start_deg or --start)")
-        return None
-    return a, b
+    return tuple(math.radians(v) for v in raw) if key == "range_deg" else (float(raw[0]), float(raw[1]))
 
 
 def _check_range_assembles(mech: Mechanism, data: Mapping[str, Any]) -> None:
@@ -328,12 +325,13 @@ def _check_range_assembles(mech: Mechanism, data: Mapping[str, Any]) -> None:
     if not len(bad):
         return
     key = "range_deg" if "range_deg" in data else "range"
-    deg = np.degrees(phi)
+    coordinate = mech.coordinate
+    deg, unit = coordinate.shown(phi), coordinate.shown_unit
     ok = np.flatnonzero(motion.status != CANNOT_ASSEMBLE)
     runs = _runs(deg, bad)
-    assembles = f"; it assembles at {_runs(deg, ok)} deg" if len(ok) else "; it assembles nowhere in it"
-    raise SchemeError(f"{key} = {data[key]!r}: the mechanism cannot be assembled at phi = {runs} deg of "
-                      f"this range{assembles} (checked at {len(phi)} angles): declare a range within "
+    assembles = f"; it assembles at {_runs(deg, ok)} {unit}" if len(ok) else "; it assembles nowhere in it"
+    raise SchemeError(f"{key} = {data[key]!r}: the mechanism cannot be assembled at {coordinate.symbol} = {runs} "
+                      f"{unit} of this range{assembles} (checked at {len(phi)} positions): declare a range within "
                       "which it assembles")
 
 

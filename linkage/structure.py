@@ -16,6 +16,7 @@ from dataclasses import dataclass
 from itertools import combinations
 
 from assur import Group, PrismaticJoint, RevoluteJoint, solver_for
+from assur.base import DrivenPrismaticJoint
 
 from .errors import StructureError
 from .model import Mechanism, Prismatic, Revolute
@@ -33,9 +34,10 @@ class Structure:
     Attributes
     ----------
     inputs : tuple of str
-        Input links, each forming a class-I mechanism with the frame.
+        Input links, each forming a class-I mechanism with the frame (a crank pinned to it, or a
+        slider driven along a frame guide).
     input_joints : dict
-        Input link -> the revolute joint pinning it to the frame.
+        Input link -> its joint with the frame (revolute for a crank, prismatic for a slider).
     joints : dict
         Pair name -> its solver-side joint (local geometry resolved), for every pair.
     groups : tuple of Group
@@ -44,14 +46,15 @@ class Structure:
 
     frame: str
     inputs: tuple[str, ...]
-    input_joints: dict[str, RevoluteJoint]
+    input_joints: dict[str, RevoluteJoint | PrismaticJoint]
     groups: tuple[Group, ...]
     joints: dict[str, RevoluteJoint | PrismaticJoint]
 
     @property
     def formula(self) -> str:
         """Structural formula, e.g. ``I(0,1) → II-RPR(2,3) → II-PRP(4,5)``."""
-        parts = [f"I({self.frame},{name})" for name in self.inputs]
+        parts = [f"I({j.name})" if isinstance(j, DrivenPrismaticJoint) else f"I({self.frame},{name})"
+                 for name, j in self.input_joints.items()]
         parts += [repr(g) for g in self.groups]
         return " → ".join(parts)
 
@@ -130,11 +133,19 @@ def decompose(mech: Mechanism) -> Structure:
     joints = {name: joint_of(pair, mech) for name, pair in mech.pairs.items()}
     input_joints = {}
     for name in mech.inputs:
-        pivot = sorted(j for j, p in mech.pairs.items()
-                       if isinstance(p, Revolute) and set(p.links) == {name, mech.frame})
-        input_joints[name] = joints[pivot[0]]
-    used = {j.name for j in input_joints.values()}
-    known = {mech.frame, *mech.inputs}
+        pair = mech.input_pair(name)
+        joint = joints[pair]
+        if mech.frame not in (joint.a, joint.b):
+            # a cylinder: the driven pair joins two moving links; its slide is the pose of a driver
+            # pseudo-link, a known link of the group that holds the pair
+            joint = joints[pair] = DrivenPrismaticJoint(**vars(joint), driver=driver_of(pair))
+            input_joints[joint.driver] = joint
+            continue
+        link = joint.b if joint.a == mech.frame else joint.a
+        input_joints[link] = joint
+    inputs = tuple(input_joints)
+    used = {j.name for j in input_joints.values() if not isinstance(j, DrivenPrismaticJoint)}
+    known = {mech.frame, *inputs}
     unknown = sorted(set(mech.links) - known)
     groups: list[Group] = []
     while unknown:
@@ -150,7 +161,18 @@ def decompose(mech: Mechanism) -> Structure:
         known |= set(group.links)
         used |= {j.name for j in group.joints}
         unknown = [k for k in unknown if k not in known]
-    return Structure(mech.frame, tuple(mech.inputs), input_joints, tuple(groups), joints)
+    return Structure(mech.frame, inputs, input_joints, tuple(groups), joints)
+
+
+def driver_of(pair: str) -> str:
+    """Name of the pseudo-link whose pose ``(s, 0, 0)`` carries the slide of the driven pair
+    ``pair`` (a cylinder input): ``"<pair>.s"``."""
+    return f"{pair}.s"
+
+
+def _rows(joints) -> int:
+    """Equations of the joints: two per pair, three for a driven one."""
+    return sum(j.rows for j in joints)
 
 
 def _group_joints(subset, known, joints, used):
@@ -162,17 +184,17 @@ def _group_joints(subset, known, joints, used):
 def _is_group(subset, known, joints, used) -> bool:
     """3 n = 2 p and no proper subset over-constrained (so none is floating)."""
     gj = _group_joints(subset, known, joints, used)
-    if 3 * len(subset) != 2 * len(gj):
+    if 3 * len(subset) != _rows(gj):
         return False
     for r in range(1, len(subset)):
         for part in combinations(subset, r):
-            if 2 * len(_group_joints(part, known, joints, used)) >= 3 * len(part):
+            if _rows(_group_joints(part, known, joints, used)) >= 3 * len(part):
                 return False
     return True
 
 
 def _next_group(unknown, known, joints, used, size) -> Group | None:
-    for n in range(2, MAX_GROUP_LINKS + 1, 2):
+    for n in range(1, MAX_GROUP_LINKS + 1):     # odd sizes only hold a driven pair (three equations)
         for subset in combinations(unknown, n):
             if not _is_group(subset, known, joints, used):
                 continue

@@ -235,6 +235,8 @@ def column_unit(name: str) -> str | None:
         return _NAMED_UNITS[name]
     if name.startswith("balancing_moment."):      # a further input link's balancing moment
         return "N m"
+    if name.startswith("balancing_force"):        # the balancing force of a slide input
+        return "N"
     _, dot, quantity = name.rpartition(".")
     if not dot:
         return None
@@ -245,8 +247,14 @@ def column_unit(name: str) -> str | None:
 
 
 def units_of(columns: Iterable[str]) -> dict[str, str | None]:
-    """``{name: column_unit(name)}`` for the given column names."""
-    return {name: column_unit(name) for name in columns}
+    """``{name: column_unit(name)}`` for the given column names. In a table whose position column
+    is a slide ``s`` (m, a slide input), analogs are per m: ``B.x'`` m/m, ``3.theta''`` rad/m^2."""
+    columns = list(columns)
+    units = {name: column_unit(name) for name in columns}
+    if "s" in columns:
+        units = {name: u.replace("/rad", "/m") if u and "'" in name else u for name, u in units.items()}
+        units["s"] = "m"
+    return units
 
 
 # ----------------------------------------------------------------------------------------------
