@@ -604,9 +604,45 @@ def _add_dynamics(sub) -> None:
                    help="with --method ode: give the start-up from the scheme's initial speed "
                         "(t, phi_deg, omega at every step of the integration, over the scheme's "
                         "cycles) instead of the per-position table")
+    stroke = p.add_argument_group(
+        "slide inputs", "A mechanism driven by a slide (a piston, a cylinder: docs/inputs.md) moves over its "
+                        "stroke once: its law of motion comes from the energy equation along the stroke. "
+                        "Columns: i, s (m), t (s), v (m/s), a (m/s^2), force, reduced_force, "
+                        "balancing_force (N), reduced_mass (kg); -n steps over the stroke (default 24).")
+    stroke.add_argument("--force", metavar="N", type=_real, default=None,
+                        help="the actuator's force along +s, N (default 0: the declared loads alone)")
+    stroke.add_argument("--initial-speed", metavar="M_S", type=_real, default=None,
+                        help="|ds/dt| at the start of the stroke, m/s (default 0: from rest)")
     _add_columns_argument(p)
     _add_format_argument(p)
     p.set_defaults(handler=_cmd_dynamics)
+
+
+def _cmd_stroke(args: argparse.Namespace, mech) -> int:
+    """``linkage dynamics`` for a slide input: the law of motion over the stroke."""
+    from .stroke import stroke_motion
+
+    crank_only = [option for option, value in (("--delta", args.delta), ("--omega", args.omega),
+                                               ("--rpm", args.rpm)) if value is not None]
+    crank_only += ["--method " + args.method] if args.method != "course" else []
+    crank_only += ["--transient"] if args.transient else []
+    if crank_only:
+        raise InputError(f"{', '.join(crank_only)}: scheme '{mech.name}' is driven by a slide (input "
+                         f"'{mech.inputs[0]}'), whose dynamics is one stroke, not a cycle of a crank: give "
+                         "--force N and --initial-speed M_S instead")
+    force = 0.0 if args.force is None else args.force
+    speed = 0.0 if args.initial_speed is None else args.initial_speed
+    if speed < 0:
+        raise InputError(f"--initial-speed {speed:g}: a speed is >= 0 m/s (the sense is the stroke's)")
+    motion = stroke_motion(mech, force, initial_speed=speed, positions=args.positions or 24)
+    columns = motion.columns()
+    start, end = mech.input_range
+    meta = {"scheme": mech.name, "start": f"s0 = {start:.10g} m (start of the stroke), v0 = {speed:.6g} m/s; s runs to "
+                                          f"{end:.10g} m in {args.positions or 24} steps",
+            "force": f"{force:.6g} N" if args.format == "table" else force,
+            "stroke_time": f"{motion.t[-1]:.6g} s" if args.format == "table" else float(motion.t[-1])}
+    _emit(columns, args, meta, None)
+    return 0
 
 
 #: units of the scalar results of ``linkage dynamics`` (the ``# key: value`` lines of the table)
@@ -632,6 +668,12 @@ def _cmd_dynamics(args: argparse.Namespace) -> int:
     from .report.results import dynamics_results
 
     mech = _load_scheme(args)
+    if not mech.coordinate.is_angle:
+        return _cmd_stroke(args, mech)
+    if args.force is not None or args.initial_speed is not None:
+        given = "--force" if args.force is not None else "--initial-speed"
+        raise InputError(f"{given}: scheme '{mech.name}' is driven by a crank (input '{mech.inputs[0]}'); "
+                         "--force and --initial-speed are for a slide input")
     if args.transient and args.method != "ode":
         raise InputError(f"--transient: the start-up is a solution of the equation of motion with the "
                          f"motor: give --method ode with it (got --method {args.method})")

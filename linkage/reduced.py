@@ -1,5 +1,8 @@
 """Reduced characteristics at the input link (docs/methods.md#reduced-moment-and-moment-of-inertia).
 
+For a slide input (docs/inputs.md) the same formulas give the reduced mass (kg) and the reduced
+force (N): the analogs are per m of the slide.
+
 With ``s = sign(omega_m)`` and ``psi = s phi`` (the angle in the direction of rotation):
 
 - reduced moment by equality of powers ``M_red = s sum(F . r'_P) + s sum(M_k theta_k')``,
@@ -145,6 +148,7 @@ def reduced_characteristics(
     crank = motion.structure.inputs[0]   # further inputs (mobility W > 1) turn by their laws: variable terms
     others = [k for k in mech.moving_links if k != crank]
     variable, half_derivative = link_inertia_terms(motion, others)
-    own, _ = link_inertia_terms(motion, [crank])
+    # the input link's own inertia (a cylinder's driver is no link: every link is a variable term)
+    own, _ = link_inertia_terms(motion, [crank] if crank in mech.links else [])
     return Reduced(motion.phi, rotation, resisting, driving, float(own[0]) + float(extra_inertia),
                    variable, 2 * rotation * half_derivative)

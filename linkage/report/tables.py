@@ -205,6 +205,11 @@ _NAMED_UNITS = {
     "reduced_inertia_derivative": "kg m^2/rad",
     "omega": "rad/s",
     "eps": "rad/s^2",
+    "v": "m/s",
+    "a": "m/s^2",
+    "force": "N",
+    "reduced_force": "N",
+    "reduced_mass": "kg",
 }
 
 #: units of ``<object>.<quantity>`` columns by quantity, for the value, ``'`` and ``''``
