@@ -29,8 +29,8 @@ for name, speed in (("piston_driven_crank", -2.0), ("cylinder_boom", 0.2)):
     output, _, _ = linkage.analyze(mech, s, order=0).quantity(mech.output.quantity)
     print(f"{name}: {linkage.structure_of(mech).formula}; stroke {s[0]:.3g} -> {s[-1]:.3g} m; "
           f"{mech.output.quantity} travels {np.ptp(output):.4g}")
-    print(f"  balancing force: static {np.min(static.balancing_moment):.1f} .. {np.max(static.balancing_moment):.1f} N; "
-          f"at {speed:g} m/s {np.min(moving.balancing_moment):.1f} .. {np.max(moving.balancing_moment):.1f} N")
+    print(f"  balancing force: static {np.min(static.balancing_moment):.1f} .. "
+          f"{np.max(static.balancing_moment):.1f} N; at {speed:g} m/s {np.min(moving.balancing_moment):.1f} .. {np.max(moving.balancing_moment):.1f} N")
 
 boom = linkage.load("cylinder_boom")
 stroke = stroke_motion(boom, force=9000.0, initial_speed=0.0, positions=40)

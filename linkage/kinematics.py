@@ -714,7 +714,8 @@ def _check_jumps(group, plan, poses, first, status, phi, coordinate) -> None:
         values = coordinate.shown(phi)
         shown = ", ".join(f"{values[j]:.6g}..{values[j + 1]:.6g}" for j in k[:5])
         warnings.warn(
-            f"group {group!r} moves between the input {coordinate.kind}s {shown} {coordinate.shown_unit} more than its analogs "
+            f"group {group!r} moves between the input {coordinate.kind}s {shown} {coordinate.shown_unit} more than "
+            "its analogs "
             "allow: it passes a change point or a singular position between them (analyse finer "
             "angles there)", BranchWarning, stacklevel=3)
 

@@ -33,7 +33,7 @@ from assur.rows import rows_of
 
 from .errors import InputError
 from .forces import LoadTerm, Loads, evaluate_loads, generalized_loads, inertia_terms, loads_of
-from .kinematics import Motion, angle_in_half_turn
+from .kinematics import Motion, angle_in_half_turn, input_angles
 
 __all__ = ["Reactions", "reactions_under", "solve_reactions", "virtual_power_residual"]
 
@@ -104,7 +104,8 @@ class Reactions:
     def columns(self, full: bool = False, direction: int | None = None) -> dict[str, np.ndarray]:
         """Table: ``i``, ``phi_deg`` (as in :meth:`Motion.columns`; ``s`` for a slide input),
         ``balancing_moment`` (N m; ``balancing_force``, N, for a slide input; with several inputs,
-        the first's, and ``balancing_moment.K`` or ``balancing_force.K`` for each further input K), per pair ``K.R`` (magnitude of ``R[a, b]``, N) and ``K.angle_deg`` (its direction, deg CCW
+        the first's, and ``balancing_moment.K`` or ``balancing_force.K`` for each further input K), per
+        pair ``K.R`` (magnitude of ``R[a, b]``, N) and ``K.angle_deg`` (its direction, deg CCW
         from +x in (-180, 180]); with ``full`` also ``K.Rx``, ``K.Ry`` (N) and, for
         prismatic pairs, ``K.M`` (N m, the moment of the slider on the guide about the slider's
         point). Pairs in the order of their names. ``direction``: see :meth:`Motion.columns`."""
@@ -255,7 +256,7 @@ def virtual_power_residual(reactions: Reactions) -> np.ndarray:
 
     With virtual velocities (the first analogs: a virtual crank rate of 1 rad/s, so the result
     does not depend on the real ``omega`` and stays defined where it is 0) the powers are
-    ``P_b = M_b`` (with several inputs, ``sum_k M_b,k theta_k'``) and ``P_t = F . r'_P + M theta_k'`` for every applied and inertia load t.
+    ``P_b = M_b`` (with several inputs, ``sum_k M_b,k q_k'``, q_k each input's angle or slide) and ``P_t = F . r'_P + M theta_k'`` for every applied and inertia load t.
     Reactions of ideal pairs do no work, so their sum is zero when the reactions are right. The
     residual is::
 
@@ -276,8 +277,9 @@ def virtual_power_residual(reactions: Reactions) -> np.ndarray:
     motion = reactions.motion
     size = motion.mechanism.size
     powers = [reactions.balancing_moment]
+    rates = input_angles(motion.mechanism, motion.structure, motion.phi)
     for link in motion.structure.inputs[1:]:
-        powers.append(reactions.balancing_moments[link] * motion.first[link][:, 2])
+        powers.append(reactions.balancing_moments[link] * rates[link][1])
     typical = np.zeros(len(motion.phi))
     for t in reactions.terms:
         pose, first = motion.poses[t.link], motion.first[t.link]

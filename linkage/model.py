@@ -535,6 +535,7 @@ class MechanismBuilder:
         self._pairs: dict[str, Revolute | Prismatic] = {}
         self._inputs: list[str] = []
         self._laws: dict[str, InputLaw] = {}
+        self._law_degrees: dict[str, tuple[str, ...]] = {}
         self._assembly: list[Assembly] = []
         self._output: Output | None = None
         self._range: tuple[float, float] | None = None
@@ -729,10 +730,15 @@ class MechanismBuilder:
         return self
 
     def input_law(self, link: str, *, ratio: float | None = None, phase: float | None = None,
-                  table=None) -> "MechanismBuilder":
+                  table=None, degrees=()) -> "MechanismBuilder":
         """The angle of the further input ``link`` as a function of the first input's ``phi``:
         ``ratio * phi + phase`` (rad; defaults 1 and 0), or ``table=(phi, theta)``, two sequences of
-        angles (rad) interpolated by a cubic spline (see :class:`~linkage.input_laws.InputLaw`)."""
+        angles (rad) interpolated by a cubic spline (see :class:`~linkage.input_laws.InputLaw`).
+        For a further input that is a slide, its slide (m) ``ratio * phi + phase`` (phase in m; no
+        table). ``degrees``: the scheme keys given in degrees (``phase_deg``, ``table_deg``), which
+        a slide refuses."""
+        if degrees:
+            self._law_degrees[link] = tuple(degrees)
         where = f"input law of link '{link}'"
         if link in self._laws:
             self._problems.append(f"{where}: declared twice")
@@ -856,6 +862,10 @@ class MechanismBuilder:
                             "range = [s_start, s_end] (m) instead")
         elif not self._inputs_refused:
             problems.extend(_range_problems(mech, self._range_given or "input range"))
+        for link, keys in self._law_degrees.items():
+            if link in mech.inputs and mech.input_kind(link) == "slide":
+                problems.append(f"input_laws.{link}: {', '.join(keys)}: input '{link}' is a slide, whose coordinate "
+                                "is in m: give ratio and phase (m)")
         if problems:
             raise SchemeError(problems)
         return mech
@@ -1002,6 +1012,10 @@ def _law_problems(mech: Mechanism) -> list[str]:
             problems.append(f"input link '{link}' needs a law (input_laws.{link}: ratio and phase_deg, or table_deg): "
                             f"how its angle follows the first input's ('{first}')")
     for link, law in mech.input_laws.items():
+        if law.table is not None and link in further and mech.input_kind(link) == "slide":
+            problems.append(f"input law of link '{link}': '{link}' is a slide: give a ratio and a phase (its slide "
+                            "= ratio * phi + phase, m), not a table")
+            continue
         if law.table is not None and link in further and not mech.coordinate.is_angle:
             problems.append(f"input law of link '{link}': a table law follows the first input's angle, but the "
                             f"first input '{first}' is a slide: give a ratio and a phase (the further input's "

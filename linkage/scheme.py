@@ -445,7 +445,8 @@ def _add_input_law(builder, link, spec, problems):
             return
         scale = math.pi / 180 if key == "table_deg" else 1.0
         table = ([row[0] * scale for row in raw], [row[1] * scale for row in raw])
-    builder.input_law(link, ratio=spec.get("ratio"), phase=phase, table=table)
+    builder.input_law(link, ratio=spec.get("ratio"), phase=phase, table=table,
+                      degrees=[key for key in ("phase_deg", "table_deg") if key in spec])
 
 
 # ----------------------------------------------------------------------------------------------

@@ -126,7 +126,8 @@ def stroke_motion(mech: Mechanism, force: float | Callable[[np.ndarray], np.ndar
     s = np.linspace(start, end, positions * SUBSTEPS + 1)
     pushed = np.broadcast_to(np.asarray(force(s) if callable(force) else force, dtype=float), s.shape)
     if not np.all(np.isfinite(pushed)):
-        raise DynamicsInputError(f"the actuator's force must be finite along the stroke, got {pushed[~np.isfinite(pushed)][:3]}")
+        raise DynamicsInputError(f"the actuator's force must be finite along the stroke, got "
+                                 f"{pushed[~np.isfinite(pushed)][:3]}")
     reduced = reduced_characteristics(mech, s, sense)
     along = sense * pushed + reduced.moment                      # N, along the travel
     energy = 0.5 * reduced.inertia[0] * initial_speed**2 + cumulative_trapezoid(along, dx=abs(s[1] - s[0]), initial=0)
