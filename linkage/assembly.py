@@ -263,7 +263,7 @@ def _never_assembles(mech, group, poses) -> None:
     """SchemeError naming the group, which assembles at no angle of the sweep, and the reason."""
     reason = group.assembly_failure(poses)
     raise SchemeError(
-        f"mechanism '{mech.name}': group {group!r} cannot be assembled at any input angle"
+        f"mechanism '{mech.name}': group {group!r} cannot be assembled at any input {mech.coordinate.kind}"
         + (f": {reason}" if reason else "") + " (check the dimensions of its links)")
 
 
@@ -406,7 +406,7 @@ def _follow(group, phi, known, known_at, periodic: bool, listed) -> list[_Trace]
     M = len(phi)
     size = float(np.max(group.size))
     if listed is None:
-        first, starts = 0, _multi_start(group, {k: v[:1] for k, v in known.items()}, size)
+        first, starts = _first_modes(group, known, size)
     else:
         present = np.flatnonzero(listed[1].any(axis=1))
         first = int(present[0]) if len(present) else 0
@@ -445,6 +445,40 @@ def _follow(group, phi, known, known_at, periodic: bool, listed) -> list[_Trace]
     extra = {k: np.concatenate(v) if v else np.empty((0, 3)) for k, v in refined.items()}
     return [_Trace({k: v[:, c] for k, v in rows.items()}, at[owner == c], {k: v[owner == c] for k, v in extra.items()})
             for c in range(count)]
+
+
+#: sweep indices between the tries of :func:`_first_modes` after the first one fails
+SCAN = 8
+
+
+def _first_modes(group, known, size: float) -> tuple[int, dict[str, np.ndarray]]:
+    """The first sweep index where Newton's method from random starts (:func:`_multi_start`) finds
+    assembly modes, and the modes found there: index 0, else every :data:`SCAN`-th index, then
+    back to the earliest index after the last one without modes (a group that does not assemble
+    at the sweep's start is traced from where it does, instead of being taken for one that never
+    assembles). No modes anywhere: index 0 and none."""
+    M = len(next(iter(known.values())))
+
+    def at(m: int) -> dict[str, np.ndarray]:
+        return _multi_start(group, {k: v[m:m + 1] for k, v in known.items()}, size)
+
+    def some(modes) -> bool:
+        return len(next(iter(modes.values()))) > 0
+
+    found = at(0)
+    if some(found):
+        return 0, found
+    empty = 0
+    for m in range(SCAN, M, SCAN):
+        found = at(m)
+        if some(found):
+            for earlier in range(empty + 1, m):
+                modes = at(earlier)
+                if some(modes):
+                    return earlier, modes
+            return m, found
+        empty = m
+    return 0, at(0)
 
 
 def _multi_start(group, at0: dict[str, np.ndarray], size: float) -> dict[str, np.ndarray]:

@@ -326,3 +326,29 @@ def test_a_newton_failure_is_reported_by_the_tables_and_the_feasibility_check(mo
     err = capsys.readouterr().err
     assert code == 0 and "did not converge" in err     # the rows stay, empty, with the warning
     assert "Traceback" not in err and "cannot be assembled" not in err
+
+
+# ----------------------------------------------------------------------------------------------
+# a group that does not assemble at the start of the sweep
+# ----------------------------------------------------------------------------------------------
+
+
+def _boom(stroke: str) -> str:
+    return (SCHEMES / "cylinder_boom.toml").read_text().replace("range = [0.6, 1.3]", stroke)
+
+
+def test_a_group_assembling_only_past_the_sweep_start_is_traced_from_there():
+    """The cylinder's group (solved by Newton's method, modes found from random starts) cannot be
+    assembled for s < |OC| - OB (the rod cannot reach B): a stroke starting there is refused
+    naming the part of the stroke that assembles -- not as a group that assembles nowhere."""
+    oc = float(np.hypot(0.6, -0.4))
+    limit = oc - 0.8 if oc > 0.8 else 0.8 - oc          # |OC - OB|, the shortest CB
+    with pytest.raises(linkage.SchemeError) as info:
+        linkage.loads(_boom("range = [0.05, 1.3]"))
+    text = str(info.value)
+    assert "cannot be assembled at s = 0.05.." in text and "it assembles at" in text, text
+    assembles_from = float(text.split("it assembles at ")[1].split("..")[0])
+    assert limit < assembles_from < limit + 0.01, (limit, text)   # within a few sweep steps of the limit
+    # a stroke wholly short of the limit: the group assembles nowhere, said in the slide's words
+    with pytest.raises(linkage.SchemeError, match="cannot be assembled at any input slide"):
+        linkage.loads(_boom("range = [0.01, 0.07]"))
