@@ -66,14 +66,16 @@ class Motion:
     Attributes
     ----------
     phi : ndarray, shape (N,)
-        Input angles, rad.
+        The first input's coordinates: angles, rad, or for a slide input its slide, m
+        (``mechanism.coordinate``).
     poses, first, second : dict of link -> ndarray (N, 3)
         Poses ``(x, y, theta)`` and their first / second analogs (``None`` when not computed).
     status : ndarray of int, shape (N,)
         0 ok, -1 cannot be assembled, -2 singular (analogs unbounded; they are NaN there), -4 a
         group solved by Newton's method did not converge (docs/groups.md; values NaN there).
     omega, eps : ndarray (N,) or None
-        Input angular velocity (rad/s) and acceleration (rad/s^2) for real velocities.
+        Input angular velocity (rad/s) and acceleration (rad/s^2) for real velocities (a slide
+        input's speed, m/s, and acceleration, m/s^2).
     conditioning : dict of group label -> ndarray (N,)
         Each analysed group's scale-free distance from a singular position (the conditioning
         ratio of ``assur.Group.conditioning``: 1 well conditioned, 0 singular; NaN where the
@@ -327,7 +329,8 @@ def analyze(
         follow their laws (:class:`~linkage.input_laws.InputLaw`); analogs are derivatives with
         respect to ``phi``.
     phi : array_like, shape (N,) or scalar
-        Input angles, rad (CCW from +x, docs/conventions.md).
+        Input angles, rad (CCW from +x, docs/conventions.md); for a slide input (a piston, a
+        cylinder: docs/inputs.md) its slide, m, and the analogs are per m.
     order : {0, 1, 2}
         Highest analog order to compute (0: positions only).
     outputs : iterable of str, optional
