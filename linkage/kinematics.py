@@ -608,8 +608,21 @@ def _failure(mech: Mechanism, phi: np.ndarray, run: _Run, structure: Structure, 
     status, conditioning = run.status, run.conditioning
     parts = []
     coordinate = mech.coordinate
+    untraced = np.zeros(len(phi), bool)
+    for i in group_ids:
+        plan = plans[i]
+        if plan.track is None or plan.periodic:
+            continue
+        low, high = plan.track[0][0], plan.track[0][-1]
+        outside = (run.solved[i] == CANNOT_ASSEMBLE) & ((phi < low - 1e-12) | (phi > high + 1e-12))
+        if outside.any():
+            untraced |= outside
+            parts.append(f"has {int(outside.sum())} {coordinate.describe(phi[outside])} outside the range "
+                         f"{coordinate.shown(low):.6g} .. {coordinate.shown(high):.6g} {coordinate.shown_unit} over "
+                         f"which the assembly mode of group {structure.groups[i]!r} is traced (it is solved by "
+                         "Newton's method from that trace: declare a range that covers them)")
     for code, what in ((CANNOT_ASSEMBLE, "cannot be assembled"), (SINGULAR, "is singular")):
-        at = phi[status == code]
+        at = phi[(status == code) & ~untraced]
         if len(at):
             parts.append(f"{what} at {len(at)} {coordinate.describe(at)}")
     unconverged = []
