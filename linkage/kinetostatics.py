@@ -55,9 +55,10 @@ class Reactions:
         The applied and inertia loads used.
     notes : tuple of str
     balancing_moments : dict of input link -> ndarray (N,)
-        The balancing moment of every input link, N m (CCW positive): with several inputs
-        (:class:`~linkage.input_laws.InputLaw`), each motor's share; the first is
-        ``balancing_moment``.
+        The balancing moment of every input link, N m (CCW positive), or force, N, for a slide
+        input: with several inputs (:class:`~linkage.input_laws.InputLaw`), each motor's share; the
+        first is ``balancing_moment``. Keyed by ``Structure.inputs`` (a cylinder's by its driver,
+        ``"K.s"`` for the pair K).
     """
 
     motion: Motion
@@ -112,9 +113,11 @@ class Reactions:
         cols = self.motion.position_columns(direction)
         load = self.motion.mechanism.coordinate.load
         cols[f"balancing_{load}"] = self.balancing_moment
-        for link in self.motion.structure.inputs[1:]:
-            kind = "moment" if self.motion.mechanism.input_kind(link) == "angle" else "force"
-            cols[f"balancing_{kind}.{link}"] = self.balancing_moments.get(link, np.full(len(self.motion.phi), np.nan))
+        mech = self.motion.mechanism
+        for link, declared in list(zip(self.motion.structure.inputs, mech.inputs))[1:]:
+            kind = "moment" if mech.input_kind(declared) == "angle" else "force"
+            missing = np.full(len(self.motion.phi), np.nan)
+            cols[f"balancing_{kind}.{declared}"] = self.balancing_moments.get(link, missing)
         for name in sorted(self.multipliers):
             cols[f"{name}.R"] = self.magnitude(name)
             cols[f"{name}.angle_deg"] = self.direction_deg(name)

@@ -680,3 +680,106 @@ def test_scale_invariance(scheme, k):
         np.testing.assert_allclose(b[0] / k, want[q] / k, rtol=1e-10, atol=1e-12, err_msg=q)
         np.testing.assert_allclose(b[1], a[1], rtol=1e-9, atol=1e-12, err_msg=q + "'")
         np.testing.assert_allclose(b[2] * k, a[2], rtol=1e-8, atol=1e-10, err_msg=q + "''")
+
+
+# ----------------------------------------------------------------------------------------------
+# two cylinders (W = 2): each cylinder's balancing force is the generalized force of its slide
+# ----------------------------------------------------------------------------------------------
+
+EXCAVATOR = """
+name = "excavator"
+inputs = ["K1", "K2"]
+range = [0.6, 1.2]
+[input_laws.K2]
+ratio = -0.5
+phase = 1.3
+
+[links.0]
+points = { O = [0.0, 0.0], C = [0.6, -0.4] }
+[links.1]
+line = ["O", "T"]
+length = 2.0
+points.B = { from = "O", distance = 0.8 }
+points.E = { from = "O", distance = 1.2 }
+mass = 50.0
+com = "T"
+[links.2]
+points = { C = [0.0, 0.0] }
+guides.axis = { through = [0.0, 0.0], angle_deg = 0 }
+mass = 5.0
+com = "C"
+[links.3]
+points = { B = [0.0, 0.0] }
+mass = 3.0
+com = "B"
+[links.4]
+line = ["T", "F"]
+length = 0.4
+points.G = { from = "T", distance = 1.2, angle_deg = 180 }
+mass = 20.0
+com = "G"
+[links.5]
+points = { E = [0.0, 0.0] }
+guides.axis = { through = [0.0, 0.0], angle_deg = 0 }
+mass = 3.0
+com = "E"
+[links.6]
+points = { F = [0.0, 0.0] }
+mass = 2.0
+com = "F"
+[pairs.O]
+links = ["0", "1"]
+[pairs.C]
+links = ["0", "2"]
+[pairs.B]
+links = ["1", "3"]
+[pairs.K1]
+kind = "P"
+links = ["2", "3"]
+guide = "axis"
+at = "B"
+[pairs.T]
+links = ["1", "4"]
+[pairs.E]
+links = ["1", "5"]
+[pairs.F]
+links = ["4", "6"]
+[pairs.K2]
+kind = "P"
+links = ["5", "6"]
+guide = "axis"
+at = "F"
+[assembly.B]
+left_of = ["O", "C"]
+[assembly.F]
+left_of = ["E", "T"]
+[loads]
+gravity = [0.0, -9.81]
+"""
+
+
+def _potential(mech, s1, s2: float) -> np.ndarray:
+    """Gravity's potential energy, J, with the first cylinder at the slides ``s1`` (m, an array)
+    and the second at ``s2`` (m), held there by a law of zero ratio, so each slide can be varied
+    alone (the mode traced over the declared stroke, as in the two-input mechanism)."""
+    held = mech.with_input_laws(K2=linkage.InputLaw(ratio=0.0, phase=s2))
+    motion = linkage.analyze(held, np.asarray(s1, float), order=0)
+    return sum(link.mass * 9.81 * (motion.poses[name][:, 1] + motion.arm(name, link.center_of_mass)[:, 1])
+               for name, link in held.links.items() if name != held.frame)
+
+
+def test_two_cylinders_each_balance_the_generalized_force_of_their_own_slide():
+    """An excavator arm with two cylinders (the second's slide a law of the first's): statically,
+    each balancing force equals dV/ds_k of gravity's potential energy with the other slide held
+    (central differences), and the tables name both (balancing_force, balancing_force.K2)."""
+    mech = linkage.loads(EXCAVATOR)
+    assert linkage.structure_of(mech).formula == "I(K1) → I(K2) → II(1,2,3) → II(4,5,6)"
+    s1, h = 0.9, 1e-5
+    s2 = -0.5 * s1 + 1.3
+    columns = solve_reactions(linkage.analyze(mech, np.array([s1]))).columns()
+    below, above = _potential(mech, [s1 - h, s1 + h], s2)
+    d1 = (above - below) / (2 * h)
+    d2 = float(_potential(mech, [s1], s2 + h)[0] - _potential(mech, [s1], s2 - h)[0]) / (2 * h)
+    assert columns["balancing_force"][0] == pytest.approx(d1, rel=1e-7)
+    assert columns["balancing_force.K2"][0] == pytest.approx(d2, rel=1e-7)
+    assert abs(d1) > 100 and abs(d2) > 100          # both cylinders carry a load here
