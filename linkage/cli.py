@@ -513,8 +513,13 @@ def _add_speed_arguments(p: argparse.ArgumentParser, what: str) -> None:
     speed.add_argument("--rpm", metavar="RPM", type=_real, help=f"{what}, rpm, signed")
 
 
-def _speed(args) -> float | None:
+def _speed(args, mech=None) -> float | None:
+    """The input speed the options give (rad/s, or m/s for a slide input of ``mech``); --rpm
+    turns a crank, so a slide input refuses it."""
     if args.rpm is not None:
+        if mech is not None and not mech.coordinate.is_angle:
+            raise InputError(f"--rpm {args.rpm:g}: scheme '{mech.name}' is driven by a slide (input "
+                             f"'{mech.inputs[0]}'), whose speed is in m/s: give --omega M_S (the slide's speed)")
         return args.rpm * RPM
     return args.omega
 
@@ -532,7 +537,10 @@ def _add_forces(sub) -> None:
                     "that link b exerts on link a for the pair's links = [a, b]; K.Rx, K.Ry (N) "
                     "and, for prismatic pairs, K.M (N m, about the slider's point). The table for "
                     "people shows the balancing moment and as many magnitudes and directions as "
-                    "fit.")
+                    "fit. A scheme driven by a slide (a piston, a cylinder) is analysed over its "
+                    "declared stroke: its columns are i, s (the slide, m), balancing_force (N, along "
+                    "+s) and the pairs'; --omega and --eps are then its speed (m/s) and acceleration "
+                    "(m/s^2).")
     _add_scheme_argument(p)
     _add_positions_arguments(p)
     _add_speed_arguments(p, "input angular velocity (default: the scheme's mean speed, else "
@@ -556,7 +564,7 @@ def _forces_view(columns: dict) -> list[str]:
 
 def _cmd_forces(args: argparse.Namespace) -> int:
     mech = _load_scheme(args)
-    results = forces_results(mech, args.positions, args.start, _speed(args), args.eps)
+    results = forces_results(mech, args.positions, args.start, _speed(args, mech), args.eps)
     _say(results)
     meta = results.meta
     if args.format == "table":
@@ -1011,10 +1019,11 @@ def _add_plans(sub) -> None:
 def _cmd_plans(args: argparse.Namespace) -> int:
     import json
 
-    from .plans import build_plans
+    from .plans import build_plans, require_crank_input
     from .report.plan_drawings import drawing_scales, write_plan_drawings
 
     mech = _load_scheme(args)
+    require_crank_input(mech)
     for option, value in (("--mu-v", args.mu_v), ("--mu-a", args.mu_a), ("--mu-f", args.mu_f)):
         if value is not None and value <= 0:
             raise InputError(f"{option} {value:g}: a scale must be positive (units per mm)")

@@ -154,8 +154,11 @@ def _find_extremes_in_range(mech: Mechanism, quantity: str, samples: int, xtol: 
     value, d1, _ = motion.quantity(quantity)
     if not np.isfinite(d1).any():
         _raise_unconverged(mech, grid, quantity, motion.status)
-        raise InputError(f"mechanism '{mech.name}' cannot be assembled at any input angle of its range")
+        raise InputError(f"mechanism '{mech.name}' cannot be assembled at any input {mech.coordinate.kind} of its "
+                         "range")
     scale = 1.0 if quantity.endswith(".theta") else mech.size
+    if not mech.coordinate.is_angle:    # analogs per m of the slide: angles 1/m, lengths 1
+        scale /= mech.size
     if not np.nanmax(np.abs(d1)) > 1e-12 * scale:
         raise InputError(f"'{quantity}' of mechanism '{mech.name}' does not move over the input range: it "
                          "has no extreme positions")
@@ -206,6 +209,14 @@ def table_angles(mech: Mechanism, n: int = 12, start: str | float = "extreme", d
     span = mech.input_range if span is None else span
     if span is not None:
         a, b = (float(v) for v in span)
+        if not mech.coordinate.is_angle:    # a slide input's stroke, m
+            if not (np.isfinite(a) and np.isfinite(b) and a != b):
+                raise InputError(f"a stroke must be two finite slides that differ, got {a:.10g}, {b:.10g} m")
+            if not (isinstance(start, str) and start == "extreme"):
+                raise InputError(f"mechanism '{mech.name}' is analysed over the stroke [{a:.10g}, {b:.10g}] m of "
+                                 f"its slide input, which fixes position 1 at its first end: a start ({start!r}) "
+                                 "applies only to a full turn of a crank")
+            return a + (b - a) * np.arange(n + 1) / n
         if not (np.isfinite(a) and np.isfinite(b) and 0 < abs(b - a) < 2 * np.pi):
             raise InputError(f"an input range must be two finite angles that differ by more than 0 and less "
                              f"than a full turn, got {np.degrees(a):.10g}, {np.degrees(b):.10g} deg")

@@ -34,7 +34,8 @@ from .kinematics import Motion, table_positions_deg
 from .model import Prismatic, Revolute
 
 __all__ = ["POLE", "VELOCITY_KINDS", "ACCELERATION_KINDS", "PlanVector", "Plan", "PolygonForce", "PolygonMoment",
-           "ForcePolygon", "LeverForce", "LeverMoment", "Lever", "Plans", "build_plans"]
+           "ForcePolygon", "LeverForce", "LeverMoment", "Lever", "Plans", "build_plans",
+           "require_crank_input"]
 
 #: the label of the pole of both plans (p of the velocity plan, pi of the acceleration plan)
 POLE = "pole"
@@ -350,6 +351,29 @@ class Plans:
 # ----------------------------------------------------------------------------------------------
 
 
+def require_crank_input(mech) -> None:
+    """Refuse a mechanism driven by a slide (a piston along a frame guide, a cylinder between two
+    links, docs/inputs.md): the plans here start from the angular velocity of a crank (rad/s) and
+    the lever gives a balancing moment (N m); a slide input would need its velocity (m/s) as the
+    pole's first vector, a cylinder's group solved on the plans by Assur's special points and a
+    balancing force on the lever, which are not implemented.
+
+    Raises
+    ------
+    InputError
+        Naming the scheme, its input and why; what to use instead.
+    """
+    if mech.inputs and not mech.coordinate.is_angle:
+        first = mech.inputs[0]
+        how = (f"the cylinder '{first}'" if first in mech.pairs else
+               f"the slider '{first}' along the guide of pair '{mech.input_pair(first)}'")
+        raise InputError(f"mechanism '{mech.name}' is driven by a slide ({how}, m): the plans of velocities and "
+                         "accelerations and Zhukovsky's lever are built for a crank input only (they start from its "
+                         "angular velocity, rad/s, and give a balancing moment, N m); use `linkage analyze` for the "
+                         "analogs per m of the slide and `linkage forces --omega M_S` for the reactions and the "
+                         "balancing force")
+
+
 def build_plans(motion: Motion, reactions=None) -> Plans:
     """Plans of velocities and accelerations, force polygons and Zhukovsky's lever of ``motion``.
 
@@ -370,10 +394,12 @@ def build_plans(motion: Motion, reactions=None) -> Plans:
     ------
     InputError
         No speed, no second analogs, or omega = 0 at some position (the plans need a moving input);
-        a motion or reactions of only some links or pairs.
+        a motion or reactions of only some links or pairs; a mechanism driven by a slide
+        (:func:`require_crank_input`).
     """
     from .kinetostatics import solve_reactions
 
+    require_crank_input(motion.mechanism)
     if motion.omega is None or motion.second is None:
         raise InputError("plans need real velocities and accelerations: analyze(..., order=2, omega=..., eps=...)")
     still = np.flatnonzero(motion.omega == 0)

@@ -107,7 +107,9 @@ def test_analyze_formats_agree_and_have_the_contract_columns(capsys, scheme):
 
     cols = read_csv(out_csv)
     names = list(cols)
-    assert names[:2] == ["i", "phi_deg"]
+    crank = mech.coordinate.is_angle
+    position = "phi_deg" if crank else "s"      # a slide input's tables lead with its slide s, m
+    assert names[:2] == ["i", position]
     # the contract: points (x y x' y' x'' y''), moving links (theta ...), prismatic slides (s ...)
     for p in mech.point_names:
         assert [n for n in names if n.rpartition(".")[0] == p] == \
@@ -123,6 +125,59 @@ def test_analyze_formats_agree_and_have_the_contract_columns(capsys, scheme):
     # + 360 deg; phi_deg counts from position 1 in the direction of rotation: 0 .. 360
     dyn = mech.extra.get("dynamics") or {}
     n = dyn.get("positions", 12)
+    doc = json.loads(out_json)
+    if not crank:
+        _check_stroke_table(mech, cols, doc, n)
+    else:
+        _check_turn_table(mech, cols, doc, n, names)
+    # JSON: the same numbers (exactly) with the metadata and the units
+    assert doc["scheme"] == mech.name
+    assert len(doc["rows"]) == n + 1
+    assert doc["units"][position] == ("deg" if crank else "m") and "i" not in doc["units"]
+    for k, row in enumerate(doc["rows"]):
+        assert list(row) == names
+        assert all(row[c] == cols[c][k] for c in names)
+    # table for people: a selection of the same numbers to the printed 7 significant digits, at
+    # most 160 characters wide, without the (constant) frame points, units under the names
+    table = read_table(out_table)
+    assert list(table)[:2] == ["i", position] and set(table) <= set(names)
+    frame_points = set(mech.links[mech.frame].points)
+    assert not {c.rpartition(".")[0] for c in table} & frame_points
+    scale = max(np.abs(v).max() for v in cols.values())
+    for c in table:
+        np.testing.assert_allclose(table[c], cols[c], rtol=1e-6, atol=1e-11 * scale, err_msg=c)
+    body = [ln for ln in out_table.splitlines() if not ln.startswith("#")]
+    assert len({len(ln) for ln in body}) == 1  # aligned: every line equally wide
+    assert len(body[0]) <= 160
+    # the units line: i has none, phi_deg is in deg (s in m)
+    assert body[1].split()[0] == ("[deg]" if crank else "[m]")
+    assert any(ln.startswith("# columns:") and "--columns '*'" in ln for ln in out_table.splitlines())
+    if not crank:   # the analogs are per m of the slide, and the table says so
+        units = doc["units"]
+        assert units[f"{mech.moving_links[0]}.theta'"] == "rad/m"
+        assert units[f"{mech.point_names[0]}.x''"] == "m/m^2"
+
+
+def _check_stroke_table(mech, cols, doc, n):
+    """A slide input's table: rows 1..n+1 in n equal steps over the declared stroke, from its
+    first end to its second; the input pair's slide is s."""
+    start, end = mech.input_range
+    np.testing.assert_array_equal(cols["i"], np.arange(1, n + 2))
+    np.testing.assert_allclose(cols["s"], start + (end - start) * np.arange(n + 1) / n, rtol=0, atol=1e-12)
+    pair = mech.input_pair(mech.inputs[0])
+    np.testing.assert_allclose(cols[f"{pair}.s"], cols["s"], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(cols[f"{pair}.s'"], 1.0, rtol=0, atol=1e-12)     # ds/ds
+    np.testing.assert_allclose(cols[f"{pair}.s''"], 0.0, rtol=0, atol=1e-12)
+    assert doc["s0"] == start and "phi0_deg" not in doc
+    assert doc["direction"] == (1 if end > start else -1)
+    for name in cols:
+        if name.endswith(".theta"):
+            assert np.all((cols[name] > -math.pi) & (cols[name] <= math.pi)), name
+
+
+def _check_turn_table(mech, cols, doc, n, names):
+    """A crank's table: n equal steps over a turn, row n+1 = row 1 + 360 deg."""
+    dyn = mech.extra.get("dynamics") or {}
     phi = cols["phi_deg"]
     assert len(phi) == n + 1
     np.testing.assert_array_equal(cols["i"], np.arange(1, n + 2))
@@ -130,7 +185,6 @@ def test_analyze_formats_agree_and_have_the_contract_columns(capsys, scheme):
     # the input link's angle is the absolute input angle phi0 + s phi_deg, in (-pi, pi], with the
     # sense s of the declared mean speed (else CCW)
     sense = -1.0 if dyn.get("mean_speed", dyn.get("mean_rpm", 1)) < 0 else 1.0
-    doc = json.loads(out_json)
     assert doc["direction"] == sense
     absolute = np.radians(doc["phi0_deg"] + sense * phi)
     theta1 = cols[f"{mech.inputs[0]}.theta"]
@@ -147,35 +201,25 @@ def test_analyze_formats_agree_and_have_the_contract_columns(capsys, scheme):
             assert abs(gap) < 1e-9, name
         else:
             assert values[-1] == pytest.approx(values[0], abs=1e-9), name
-    # JSON: the same numbers (exactly) with the metadata and the units
-    assert doc["scheme"] == mech.name
-    assert len(doc["rows"]) == n + 1
-    assert doc["units"]["phi_deg"] == "deg" and "i" not in doc["units"]
-    for k, row in enumerate(doc["rows"]):
-        assert list(row) == names
-        assert all(row[c] == cols[c][k] for c in names)
-    # table for people: a selection of the same numbers to the printed 7 significant digits, at
-    # most 160 characters wide, without the (constant) frame points, units under the names
-    table = read_table(out_table)
-    assert list(table)[:2] == ["i", "phi_deg"] and set(table) <= set(names)
-    frame_points = set(mech.links[mech.frame].points)
-    assert not {c.rpartition(".")[0] for c in table} & frame_points
-    scale = max(np.abs(v).max() for v in cols.values())
-    for c in table:
-        np.testing.assert_allclose(table[c], cols[c], rtol=1e-6, atol=1e-11 * scale, err_msg=c)
-    body = [ln for ln in out_table.splitlines() if not ln.startswith("#")]
-    assert len({len(ln) for ln in body}) == 1  # aligned: every line equally wide
-    assert len(body[0]) <= 160
-    assert body[1].split()[0] == "[deg]"  # the units line: i has none, phi_deg is in deg
-    assert any(ln.startswith("# columns:") and "--columns '*'" in ln for ln in out_table.splitlines())
 
 
 @pytest.mark.parametrize("scheme", SHIPPED)
 def test_default_start_is_the_declared_extreme(capsys, scheme):
-    """Position 1 is where the output is largest (start = "max") or smallest, over a dense sweep."""
+    """Position 1 is where the output is largest (start = "max") or smallest, over a dense sweep;
+    over a declared input range (a slide input's stroke) position 1 is the range's first end,
+    and --start, which picks position 1 on a turn, is refused naming the range."""
     mech = linkage.load(scheme)
     quantity = mech.output.quantity
     cols = analyze_csv(capsys, scheme)
+    if mech.input_range is not None:
+        first = cols["phi_deg"][0] if "phi_deg" in cols else cols["s"][0]
+        assert first == (0.0 if mech.coordinate.is_angle else mech.input_range[0])
+        code, _, err = run(capsys, "analyze", scheme, "--start", "0")
+        a, b = mech.coordinate.shown(mech.input_range)
+        declared = (f"range_deg = [{a:.10g}, {b:.10g}]" if mech.coordinate.is_angle
+                    else f"range = [{a:.10g}, {b:.10g}] m")
+        assert code == 2 and declared in err and "--start 0" in err, err
+        return
     dense = analyze_csv(capsys, scheme, "--positions", "720", "--start", "0")
     assert abs(cols[quantity + "'"][0]) < 1e-9
     if mech.output.start == "max":
@@ -187,6 +231,8 @@ def test_default_start_is_the_declared_extreme(capsys, scheme):
 @pytest.mark.parametrize("scheme", SHIPPED)
 def test_analogs_match_finite_differences_of_positions(capsys, scheme):
     """x' and x'' of every column against five-point differences of the positions (docs/methods.md#checks)."""
+    if not linkage.load(scheme).coordinate.is_angle:
+        return _slide_analogs_match_finite_differences(capsys, scheme)
     phi0_deg, h_deg = 17.0, 0.5
     samples = [analyze_csv(capsys, scheme, "--positions", "1", "--start", repr(phi0_deg + k * h_deg))
                for k in (-2, -1, 0, 1, 2)]
@@ -205,6 +251,29 @@ def test_analogs_match_finite_differences_of_positions(capsys, scheme):
         tol = 1e-6 * (1.0 if name.endswith(".theta") else size)
         assert at[name + "'"][2] == pytest.approx(d1, abs=tol), name
         assert at[name + "''"][2] == pytest.approx(d2, abs=10 * tol), name
+
+
+def _slide_analogs_match_finite_differences(capsys, scheme):
+    """A slide input: the analogs per m in rows of a dense table over the stroke (step h, m)
+    against five-point differences of the positions of the neighbouring rows."""
+    mech = linkage.load(scheme)
+    n = 400
+    cols = analyze_csv(capsys, scheme, "--positions", str(n))
+    start, end = mech.input_range
+    h = (end - start) / n   # signed: the table runs from start to end
+    np.testing.assert_allclose(np.diff(cols["s"]), h, rtol=1e-9)
+    size = max(np.abs(cols[c]).max() for c in cols if c.endswith((".x", ".y", ".s")))
+    rows = np.arange(2, n - 1, 37)
+    for name in cols:
+        if name in ("i", "s") or name.endswith("'"):
+            continue
+        values = np.unwrap(cols[name]) if name.endswith(".theta") else cols[name]
+        f = [values[rows + k] for k in (-2, -1, 0, 1, 2)]
+        d1 = (f[0] - 8 * f[1] + 8 * f[3] - f[4]) / (12 * h)
+        d2 = (-f[0] + 16 * f[1] - 30 * f[2] + 16 * f[3] - f[4]) / (12 * h * h)
+        tol = 1e-6 * (1.0 / size if name.endswith(".theta") else 1.0)   # per m: rad/m, m/m
+        np.testing.assert_allclose(cols[name + "'"][rows], d1, rtol=0, atol=tol, err_msg=name)
+        np.testing.assert_allclose(cols[name + "''"][rows], d2, rtol=0, atol=10 * tol / size, err_msg=name)
 
 
 # ----------------------------------------------------------------------------------------------

@@ -196,15 +196,23 @@ def test_forces_every_scheme_every_format(capsys, scheme):
     assert "Traceback" not in err_csv + err_table + err_json
 
     cols = read_csv(out_csv)
-    expected = ["i", "phi_deg", "balancing_moment"] + [f"balancing_moment.{k}" for k in mech.inputs[1:]]
+    crank = mech.coordinate.is_angle
+    # a slide input: the position column is its slide s (m), balanced by a force (N)
+    position, balancing = ("phi_deg", "balancing_moment") if crank else ("s", "balancing_force")
+    expected = ["i", position, balancing] + [f"{balancing}.{k}" for k in mech.inputs[1:]]
     expected += [f"{k}.{c}" for k in pairs for c in ("R", "angle_deg")]
     # CSV and JSON: every column, the components (and K.M for prismatic pairs) too
     extra = [f"{k}.{c}" for k in pairs for c in ("Rx", "Ry")] + [f"{k}.M" for k in prismatic]
     assert sorted(cols) == sorted(expected + extra)
-    assert list(cols)[:3] == ["i", "phi_deg", "balancing_moment"]
+    assert list(cols)[:3] == ["i", position, balancing]
     n = (mech.extra.get("dynamics") or {}).get("positions", 12)  # the scheme's, else 12
-    assert len(cols["phi_deg"]) == n + 1
-    np.testing.assert_allclose(cols["phi_deg"], 360.0 / n * np.arange(n + 1), rtol=0, atol=1e-9)
+    assert len(cols[position]) == n + 1
+    if crank:
+        np.testing.assert_allclose(cols["phi_deg"], 360.0 / n * np.arange(n + 1), rtol=0, atol=1e-9)
+    else:   # n equal steps over the declared stroke, from its first end
+        a, b = mech.input_range
+        np.testing.assert_allclose(cols["s"], a + (b - a) * np.arange(n + 1) / n, rtol=0, atol=1e-12)
+        assert doc["units"][balancing] == "N" and doc["units"]["s"] == "m"
     assert sorted(full) == sorted(expected + extra)
     for name in expected + extra:
         np.testing.assert_array_equal(full[name], cols[name], err_msg=name)
@@ -221,7 +229,7 @@ def test_forces_every_scheme_every_format(capsys, scheme):
         assert np.all((full[f"{k}.angle_deg"] > -180) & (full[f"{k}.angle_deg"] <= 180)), k
     # table: the balancing moment and some reactions, the same numbers to the printed digits
     table = read_table(out_table)
-    assert list(table)[:3] == ["i", "phi_deg", "balancing_moment"] and set(table) <= set(cols)
+    assert list(table)[:3] == ["i", position, balancing] and set(table) <= set(cols)
     assert max(len(ln) for ln in out_table.splitlines() if not ln.startswith("#")) <= 160
     for name in table:
         scale = np.abs(cols[name]).max()

@@ -52,7 +52,9 @@ def test_custom_mechanism_example_reports_the_lever_stroke(tmp_path):
 def test_draw_mechanism_puts_every_pair_where_the_analysis_has_it(name):
     """A revolute pair is a circle at its point, a prismatic pair the slider's block centred there."""
     mech = linkage.load(name)
-    motion = linkage.analyze(mech, np.radians([40.0]))
+    # a crank at 40 deg; a slide input 40 % into its stroke
+    at = np.radians([40.0]) if mech.coordinate.is_angle else [np.dot([0.6, 0.4], mech.input_range)]
+    motion = linkage.analyze(mech, at)
     ax = draw_mechanism(motion, 0)
     artists = {p.get_gid(): p for p in ax.patches if p.get_gid()}
     for pair in mech.pairs.values():

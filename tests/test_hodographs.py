@@ -73,9 +73,12 @@ def test_every_shipped_schemes_main_pairs_hold_its_frame_and_input_pairs():
     for name in linkage.shipped_schemes():
         mech = linkage.load(name)
         pairs = main_pairs(mech)
-        want = {k for k, p in mech.pairs.items() if mech.frame in p.links or set(p.links) & set(mech.inputs)}
+        # an input named by a pair (a cylinder) stands for the links it joins
+        inputs = set().union(*(set(mech.pairs[n].links) - {mech.frame} if n in mech.pairs else {n}
+                               for n in mech.inputs))
+        want = {k for k, p in mech.pairs.items() if mech.frame in p.links or set(p.links) & inputs}
         assert set(pairs) == want and len(pairs) == len(want), name
-        assert mech.frame in mech.pairs[pairs[0]].links and set(mech.pairs[pairs[0]].links) & set(mech.inputs)
+        assert mech.frame in mech.pairs[pairs[0]].links and set(mech.pairs[pairs[0]].links) & inputs
 
 
 # -- the plotted points are the reactions ---------------------------------------------------------

@@ -34,6 +34,20 @@ M1, M2, J2, M3 = 30.0, 400.0, 8.35, 500.0
 
 PHI = np.linspace(0.0, 2 * np.pi, 36, endpoint=False) + 0.0123  # 36 positions, none special
 N = len(PHI)
+SLIDE_SPEED = 0.85  # m/s, the speed of a slide input (its OMEGA)
+
+
+def positions(mech) -> np.ndarray:
+    """PHI (rad) for a crank; for a slide input, 36 slides (m) inside its declared stroke."""
+    if mech.coordinate.is_angle:
+        return PHI
+    a, b = mech.input_range
+    return a + (b - a) * (np.arange(N) + 0.5) / N
+
+
+def speed(mech) -> float:
+    """The input's speed: OMEGA (rad/s) for a crank, SLIDE_SPEED (m/s) for a slide."""
+    return OMEGA if mech.coordinate.is_angle else SLIDE_SPEED
 
 
 def cross(a, b):
@@ -286,7 +300,7 @@ def _loaded_scheme(name: str):
     point = sorted(data["links"][last]["points"])[-1]
     force = [-350.0, 120.0]
     shipped = linkage.load(name)
-    turning = linkage.analyze(shipped, PHI, order=1).first
+    turning = linkage.analyze(shipped, positions(shipped), order=1).first
     crank = shipped.inputs[0]
     rotating = [k for k in moving if k != crank and np.ptp(turning[k][:, 2]) > 1e-6] or [crank]
     moments = [(moving[1], -17.5), (rotating[0], 6.25)]
@@ -347,8 +361,9 @@ def test_virtual_power_every_shipped_scheme(name):
     mech, extras = _loaded_scheme(name)
     assert all(mech.links[k].mass > 0 for k in mech.moving_links)
     assert not loads_of(mech).notes
-    omega, eps = OMEGA, 23.0 * np.cos(PHI) + 4.0
-    motion = linkage.analyze(mech, PHI, omega=omega, eps=eps)
+    # eps: rad/s^2 for a crank, m/s^2 for a slide (its speed, m/s, times 1/s)
+    omega, eps = speed(mech), (23.0 * np.cos(PHI) + 4.0) * abs(speed(mech) / OMEGA)
+    motion = linkage.analyze(mech, positions(mech), omega=omega, eps=eps)
     r = solve_reactions(motion)
     kinds = {t.kind for t in r.terms}
     assert kinds == {"gravity", "inertia", "external"}
@@ -365,7 +380,7 @@ def test_every_dyad_kind_is_exercised():
 @pytest.mark.parametrize("name", SCHEMES)
 def test_action_equals_reaction_every_shipped_scheme(name):
     mech, _ = _loaded_scheme(name)
-    r = solve_reactions(linkage.analyze(mech, PHI, omega=OMEGA, eps=5.0))
+    r = solve_reactions(linkage.analyze(mech, positions(mech), omega=speed(mech), eps=5.0))
     for pair in mech.pairs.values():
         a, b = pair.links
         np.testing.assert_array_equal(r.on(a, b), -r.on(b, a))

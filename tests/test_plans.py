@@ -23,7 +23,10 @@ from linkage.plans import POLE, build_plans
 from _cli_io import run
 
 ROOT = Path(__file__).resolve().parent.parent
-SHIPPED = list(linkage.shipped_schemes())
+#: the plans are built for a crank input; a scheme driven by a slide is refused (see
+#: test_plans_refuse_a_slide_input_naming_the_scheme_and_why)
+SHIPPED = [n for n in linkage.shipped_schemes() if linkage.load(n).coordinate.is_angle]
+SLIDE_DRIVEN = [n for n in linkage.shipped_schemes() if not linkage.load(n).coordinate.is_angle]
 OMEGA, EPS = -7.3, 2.9            # rad/s, rad/s^2: a crank that speeds up while it turns clockwise
 
 # slider_crank.toml: crank OA, rod AB with S2 0.0741 m from A, slider B on the guide y = E
@@ -317,6 +320,23 @@ def test_several_inputs_carry_the_further_balancing_moments_to_the_lever(every_s
     assert [m.label for m in moments] == ["Mb4"]
     assert [p.step for p in plans.polygons][:2] == ["I(0,1)", "I(0,4)"]
     np.testing.assert_array_equal(moments[0].value, plans.reactions.balancing_moments["4"])
+
+
+@pytest.mark.parametrize("name", SLIDE_DRIVEN)
+def test_plans_refuse_a_slide_input_naming_the_scheme_and_why(capsys, name):
+    """The graphical method starts from a crank's angular velocity: a slide input (a piston, a
+    cylinder) is refused by the library and the command line, naming the scheme, the input and
+    what to use instead; nothing is printed on stdout."""
+    mech = linkage.load(name)
+    motion = linkage.analyze(mech, np.linspace(*mech.input_range, 5), omega=0.5, eps=0.1)
+    with pytest.raises(InputError) as caught:
+        build_plans(motion)
+    message = str(caught.value)
+    assert f"mechanism '{name}' is driven by a slide" in message and "crank input only" in message
+    assert f"'{mech.inputs[0]}'" in message and "linkage forces" in message
+    code, out, err = run(capsys, "plans", name, "--position", 2, "--omega", 0.5)
+    assert code == 2 and out == "" and "Traceback" not in err
+    assert f"mechanism '{name}' is driven by a slide" in err and "crank input only" in err
 
 
 def test_plans_need_a_moving_input():

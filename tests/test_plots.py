@@ -129,7 +129,15 @@ def test_drawing_of_every_scheme_is_inside_its_frame_with_clear_labels(name):
         assert ax.get_aspect() == 1.0
         _assert_labels_clear(ax.figure)
         title = ax.get_title("left")
-        assert f"Position {position + 1} of 13" in title and "crank turned" in title and "°" in title
+        assert f"Position {position + 1} of 13" in title
+        mech = motion.mechanism
+        if mech.coordinate.is_angle:
+            assert "crank turned" in title and "°" in title
+        else:   # how far the slide input moved from position 1 and where it is, in m
+            moved = abs(motion.phi[position] - motion.phi[0])
+            verb = "cylinder extended by" if mech.inputs[0] in mech.pairs else "input slider moved"
+            assert f"{verb} {moved:.4g} m" in title.replace("\n", " "), title
+            assert f"s = {motion.phi[position]:.4g} m" in title.replace("\n", " ") and "°" not in title, title
         plt.close(ax.figure)
 
 

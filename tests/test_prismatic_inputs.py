@@ -319,8 +319,6 @@ def test_piston_columns_name_the_slide(piston, capsys):
     np.testing.assert_allclose(read_table(out)["s"], np.linspace(0.48, 0.32, 13), atol=1e-6)
 
 
-@pytest.mark.xfail(strict=True, reason="JSON header of a slide input gives phi0_deg = degrees(s0) (27.50 for s0 = "
-                                       "0.48 m): the slide converted as if it were an angle in rad")
 def test_piston_json_header_does_not_show_the_slide_in_degrees(capsys):
     code, out, err = run(capsys, "analyze", "piston_driven_crank", "--format", "json")
     assert code == 0, err
@@ -330,10 +328,6 @@ def test_piston_json_header_does_not_show_the_slide_in_degrees(capsys):
     assert not wrong
 
 
-@pytest.mark.xfail(strict=True, reason="linkage analyze --range A B for a slide input converts A, B from deg to "
-                                       "rad: --range 0.45 0.35 analyses s = 0.00785..0.00611 m (all rows NaN, "
-                                       "warning 'input angle phi = 0.45, 0.4, 0.35 deg') instead of s = 0.45..0.35 "
-                                       "m or a refusal")
 def test_piston_cli_range_is_a_stroke_in_m(capsys):
     code, out, err = run(capsys, "analyze", "piston_driven_crank", "--range", "0.45", "0.35", "--format", "csv",
                          "-n", "4")

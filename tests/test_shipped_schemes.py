@@ -38,6 +38,8 @@ EXPECTED_FORMULAS = {
     "watt_six_bar": "I(0,1) → II-RRR(2,3) → II-RRR(4,5)",
     "stephenson_six_bar": "I(0,1) → II-RRR(2,3) → II-RRR(4,5)",
     "five_bar_two_input": "I(0,1) → I(0,4) → II-RRR(2,3)",   # two cranks place one dyad
+    "piston_driven_crank": "I(0,3) → II-RRR(1,2)",      # the piston (link 3) driven along the frame guide
+    "cylinder_boom": "I(K) → II(1,2,3)",                # the cylinder K: boom, barrel and rod in one group
 }
 
 SCHEMES = sorted(linkage.shipped_schemes())
@@ -47,6 +49,7 @@ PHI = np.radians(np.arange(72) * 5.0 + 1.0)
 
 CLOSURE_TOL = 1e-12
 H1, H2 = 1e-3, 5e-3  # finite-difference steps (rad) for first / second analogs
+SLIDE_STEP = 0.25    # a slide input's steps: H1, H2 times this fraction of the mechanism's size (m)
 FD_TOL1, FD_TOL2 = 1e-7, 1e-5
 
 
@@ -55,9 +58,27 @@ def mech(name):
     return linkage.load(name)
 
 
+def positions(name):
+    """The sampled input coordinates: PHI for a crank; for a slide input (m), 72 slides across its
+    declared stroke, kept 2 H2 inside both ends so that the finite differences stay in it."""
+    m = mech(name)
+    if m.coordinate.is_angle:
+        return PHI
+    a, b = m.input_range
+    h2 = steps(name)[1]
+    lo, hi = min(a, b) + 2 * h2, max(a, b) - 2 * h2
+    return lo + (hi - lo) * (np.arange(72) + 0.5) / 72
+
+
+def steps(name):
+    """Finite-difference steps (h1, h2) of the input coordinate: rad for a crank, m for a slide."""
+    m = mech(name)
+    return (H1, H2) if m.coordinate.is_angle else (H1 * SLIDE_STEP * m.size, H2 * SLIDE_STEP * m.size)
+
+
 @lru_cache(maxsize=None)
 def motion(name):
-    return linkage.analyze(mech(name), PHI, order=2)
+    return linkage.analyze(mech(name), positions(name), order=2)
 
 
 def rot(theta, p):
@@ -116,14 +137,23 @@ def test_loads_with_formula_and_output(name):
     assert m.description, "every shipped scheme describes itself"
     assert m.output is not None and m.output.start in ("max", "min")
     ext = linkage.extreme_positions(m)  # the declared output has extreme positions
-    assert len(ext.roots) >= 1 and ext.value_max >= ext.value_min
+    assert ext.value_max >= ext.value_min
+    if m.input_range is None:           # over a turn: roots of the output's analog
+        assert len(ext.roots) >= 1
+    else:                               # within a range (a stroke): a root or an end of it
+        candidates = np.concatenate([m.input_range, ext.roots])
+        for where, value in ((ext.phi_max, ext.value_max), (ext.phi_min, ext.value_min)):
+            assert np.min(np.abs(candidates - where)) <= 1e-12
+            assert value == pytest.approx(linkage.analyze(m, [where]).quantity(m.output.quantity)[0][0], abs=1e-12)
+        probe = linkage.analyze(m, np.linspace(*m.input_range, 101)).quantity(m.output.quantity)[0]
+        assert ext.value_min - 1e-12 <= probe.min() and probe.max() <= ext.value_max + 1e-12
 
 
 @pytest.mark.parametrize("name", SCHEMES)
 def test_analyzes_over_a_revolution(name):
     with warnings.catch_warnings():
         warnings.simplefilter("error", BranchWarning)
-        mo = linkage.analyze(mech(name), PHI, order=2)
+        mo = linkage.analyze(mech(name), positions(name), order=2)
     assert np.all(mo.success)
     for q in quantities(mech(name)):
         for arr in mo.quantity(q):
@@ -154,14 +184,17 @@ def test_loop_closure(name):
             # the reported slide is the distance along the guide from the guide's point
             s = mo.quantity(f"{pname}.s")[0]
             assert np.allclose(s, np.sum(u * (P - G), axis=1), rtol=0, atol=tol), pname
-    # the input link's angle is phi
-    assert np.allclose(wrap(mo.poses[m.inputs[0]][:, 2] - PHI), 0, atol=CLOSURE_TOL)
+    if m.coordinate.is_angle:   # the input link's angle is phi
+        assert np.allclose(wrap(mo.poses[m.inputs[0]][:, 2] - PHI), 0, atol=CLOSURE_TOL)
+    else:                       # the input pair's slide (measured above from the poses) is s
+        s = mo.quantity(f"{m.input_pair(m.inputs[0])}.s")[0]
+        assert np.allclose(s, positions(name), rtol=0, atol=tol)
 
 
 def _fd_samples(name, offsets):
     """Values of every quantity at PHI + k for k in offsets: dict q -> (len(offsets), N)."""
     m = mech(name)
-    phi = np.concatenate([PHI + k for k in offsets])
+    phi = np.concatenate([positions(name) + k for k in offsets])
     mo = linkage.analyze(m, phi, order=0)
     out = {}
     for q in quantities(m):
@@ -177,15 +210,18 @@ def _fd_samples(name, offsets):
 def test_analogs_match_finite_differences(name):
     """5-point central differences: O(h^4) for both the first and the second derivative."""
     m, mo = mech(name), motion(name)
-    s1 = _fd_samples(name, [-2 * H1, -H1, 0.0, H1, 2 * H1])
-    s2 = _fd_samples(name, [-2 * H2, -H2, 0.0, H2, 2 * H2])
+    h1, h2 = steps(name)
+    s1 = _fd_samples(name, [-2 * h1, -h1, 0.0, h1, 2 * h1])
+    s2 = _fd_samples(name, [-2 * h2, -h2, 0.0, h2, 2 * h2])
     for q in quantities(m):
         value, d1, d2 = mo.quantity(q)
         f = s1[q]
-        fd1 = (f[0] - 8 * f[1] + 8 * f[3] - f[4]) / (12 * H1)
+        fd1 = (f[0] - 8 * f[1] + 8 * f[3] - f[4]) / (12 * h1)
         f = s2[q]
-        fd2 = (-f[0] + 16 * f[1] - 30 * f[2] + 16 * f[3] - f[4]) / (12 * H2**2)
-        length = 1.0 if q.endswith(".theta") else m.size  # m/rad for lengths, 1 for angles
+        fd2 = (-f[0] + 16 * f[1] - 30 * f[2] + 16 * f[3] - f[4]) / (12 * h2**2)
+        # the analogs' natural scale: per rad, m for lengths and 1 for angles; per m of a slide
+        # input, 1 for lengths and 1/m for angles
+        length = (1.0 if q.endswith(".theta") else m.size) / (1.0 if m.coordinate.is_angle else m.size)
         scale1 = max(np.max(np.abs(d1)), length)
         scale2 = max(np.max(np.abs(d2)), length)
         assert np.max(np.abs(d1 - fd1)) <= FD_TOL1 * scale1, (q, np.max(np.abs(d1 - fd1)) / scale1)
@@ -198,7 +234,7 @@ def test_roundtrip(name):
     again = linkage.loads(linkage.dumps(m))
     assert again == m
     assert linkage.structure_of(again).formula == EXPECTED_FORMULAS[name]
-    a, b = linkage.analyze(m, PHI), linkage.analyze(again, PHI)
+    a, b = linkage.analyze(m, positions(name)), linkage.analyze(again, positions(name))
     for p in m.point_names:
         assert np.array_equal(a.point(p), b.point(p)), p
 

@@ -29,6 +29,15 @@ SHIPPED = sorted(p.stem for p in SCHEMES_DIR.glob("*.toml"))
 #: input angles away from the singular positions of the shipped schemes
 PHI = 0.1 + np.arange(24) * (2 * np.pi / 24)
 
+
+def positions(mech: linkage.Mechanism) -> np.ndarray:
+    """The sampled input coordinates: PHI (rad) for a crank; 24 slides (m) inside the declared
+    stroke of a slide input."""
+    if mech.coordinate.is_angle:
+        return PHI
+    a, b = mech.input_range
+    return a + (b - a) * (np.arange(24) + 0.5) / 24
+
 # ----------------------------------------------------------------------------------------------
 # mobility
 # ----------------------------------------------------------------------------------------------
@@ -48,6 +57,8 @@ HAND_MOBILITY = {
     "watt_six_bar": 3 * 5 - 2 * 7,           # links 1..5; seven revolute pairs
     "stephenson_six_bar": 3 * 5 - 2 * 7,     # links 1..5; seven revolute pairs
     "five_bar_two_input": 3 * 4 - 2 * 5,     # links 1..4; pairs O A B D Q
+    "piston_driven_crank": 3 * 3 - 2 * 4,    # links 1 2 3; pairs O A B slide
+    "cylinder_boom": 3 * 3 - 2 * 4,          # links 1 2 3; pairs O C B K
 }
 
 #: structural formulas derived by hand from the scheme files (docs/methods.md#structure)
@@ -68,6 +79,12 @@ HAND_FORMULA = {
     "stephenson_six_bar": "I(0,1) → II-RRR(2,3) → II-RRR(4,5)",
     # cranks 1 (O, A) and 4 (Q, D) on the frame; couplers 2 (A, B) and 3 (D, B) meet at B
     "five_bar_two_input": "I(0,1) → I(0,4) → II-RRR(2,3)",
+    # the piston 3 is driven along the frame's guide (class I with the frame); crank 1 and rod 2
+    # meet at A: a dyad with its outer pairs O (frame) and B (piston)
+    "piston_driven_crank": "I(0,3) → II-RRR(1,2)",
+    # the cylinder K drives the slide between barrel 2 and rod 3: with it given, boom 1, barrel 2
+    # and rod 3 have 9 unknowns and 9 equations (O, C, B: 2 each; K: 3), no subset closed
+    "cylinder_boom": "I(K) → II(1,2,3)",
 }
 
 
@@ -344,7 +361,7 @@ def test_toml_section_order_does_not_matter(name):
     top, sections = toml_sections(text)
     reference = linkage.loads(text)
     formula = linkage.decompose(reference).formula
-    motion = linkage.analyze(reference, PHI)
+    motion = linkage.analyze(reference, positions(reference))
     rng = random.Random(20240601)
     orders = set()
     for _ in range(4):
@@ -354,7 +371,7 @@ def test_toml_section_order_does_not_matter(name):
         orders.add((tuple(mech.links), tuple(mech.pairs)))
         assert (mech.links, mech.pairs, mech.inputs) == (reference.links, reference.pairs, reference.inputs)
         assert linkage.decompose(mech).formula == formula
-        assert_same_motion(linkage.analyze(mech, PHI), motion)
+        assert_same_motion(linkage.analyze(mech, positions(mech)), motion)
     assert len(orders) > 1, "the permutations did not change the declaration order"
 
 
@@ -449,6 +466,8 @@ def scaled(mech: linkage.Mechanism, k: float) -> linkage.Mechanism:
         spec["inertia"] = k * k * spec["inertia"]
         for guide in spec.get("guides", {}).values():
             guide["through"] = [k * c for c in guide["through"]]
+    if "range" in data and not mech.coordinate.is_angle:    # a slide input's stroke, m
+        data["range"] = [k * v for v in data["range"]]
     return from_dict(data)
 
 
@@ -506,55 +525,74 @@ def quantities(mech: linkage.Mechanism):
 @pytest.mark.parametrize("name", SHIPPED + sorted(BUILT))
 def test_mirror_invariance(name):
     """Mirrored at pi - phi: P = (-x, y), P' = (x', -y'), P'' = (-x'', y''); theta = pi - theta,
-    theta' = theta', theta'' = -theta''; s = s, s' = -s', s'' = s'' (d/d(pi - phi) = -d/dphi)."""
+    theta' = theta', theta'' = -theta''; s = s, s' = -s', s'' = s'' (d/d(pi - phi) = -d/dphi).
+
+    A slide input's coordinate is a slide, which the mirror keeps (``s = u . d`` with ``u`` and
+    ``d`` both mirrored): at the same s, P = (-x, y), P' = (-x', y'), P'' = (-x'', y''); theta =
+    pi - theta, theta' = -theta', theta'' = -theta''; s, s', s'' unchanged."""
     mech = mechanism(name)
     mirror = mirrored(mech)
     assert linkage.decompose(mirror).formula == linkage.decompose(mech).formula
     size = mech.size
-    orig = linkage.analyze(mech, PHI)
-    image = linkage.analyze(mirror, np.pi - PHI)
+    at = positions(mech)
+    crank = mech.coordinate.is_angle
+    orig = linkage.analyze(mech, at)
+    image = linkage.analyze(mirror, np.pi - at if crank else at)
     points, links, slides = quantities(mech)
     flip_x, flip_y = np.array([-1.0, 1.0]), np.array([1.0, -1.0])
+    sign = 1.0 if crank else -1.0   # d/d(pi - phi) = -d/dphi; d/ds unchanged
+    # analogs per m of a slide input are dimensionless (points) or per m (angles)
+    scale1 = 1.0 if crank else 1.0 / size
     for p in points:
         (d1, d2), (e1, e2) = orig.point_analogs(p), image.point_analogs(p)
         np.testing.assert_allclose(image.point(p), orig.point(p) * flip_x, rtol=0, atol=1e-12 * size, err_msg=p)
-        np.testing.assert_allclose(e1, d1 * flip_y, rtol=0, atol=1e-12 * size, err_msg=p + "'")
-        np.testing.assert_allclose(e2, d2 * flip_x, rtol=0, atol=1e-12 * size, err_msg=p + "''")
+        np.testing.assert_allclose(e1, sign * d1 * flip_y, rtol=0, atol=1e-12 * size * scale1, err_msg=p + "'")
+        np.testing.assert_allclose(e2, d2 * flip_x, rtol=0, atol=1e-12 * size * scale1**2, err_msg=p + "''")
     for q in links:
         (t, t1, t2), (u, u1, u2) = orig.quantity(q), image.quantity(q)
         np.testing.assert_allclose(wrapped(u - (np.pi - t)), 0.0, rtol=0, atol=1e-12, err_msg=q)
-        np.testing.assert_allclose(u1, t1, rtol=1e-12, atol=1e-12, err_msg=q + "'")
-        np.testing.assert_allclose(u2, -t2, rtol=1e-12, atol=1e-12, err_msg=q + "''")
+        np.testing.assert_allclose(u1, sign * t1, rtol=1e-12, atol=1e-12 * scale1, err_msg=q + "'")
+        np.testing.assert_allclose(u2, -t2, rtol=1e-12, atol=1e-12 * scale1**2, err_msg=q + "''")
     for q in slides:
         (s, s1, s2), (r, r1, r2) = orig.quantity(q), image.quantity(q)
         np.testing.assert_allclose(r, s, rtol=0, atol=1e-12 * size, err_msg=q)
-        np.testing.assert_allclose(r1, -s1, rtol=0, atol=1e-12 * size, err_msg=q + "'")
-        np.testing.assert_allclose(r2, s2, rtol=0, atol=1e-12 * size, err_msg=q + "''")
+        np.testing.assert_allclose(r1, -sign * s1, rtol=0, atol=1e-12 * size * scale1, err_msg=q + "'")
+        np.testing.assert_allclose(r2, s2, rtol=0, atol=1e-12 * size * scale1**2, err_msg=q + "''")
 
 
 @pytest.mark.parametrize("k", [1e-3, 1e3, 1e-6, 1e6])
 @pytest.mark.parametrize("name", SHIPPED + sorted(BUILT))
 def test_scale_invariance(name, k):
-    """Lengths x k: positions, point and slide analogs x k; link angles and their analogs equal."""
+    """Lengths x k: positions, point and slide analogs x k; link angles and their analogs equal.
+
+    A slide input's stroke is a length too (scaled with the rest) and so is its coordinate: at
+    the slide k s, the analogs per m of order n scale as k^(1 - n) for points and slides and
+    k^(-n) for angles (d/d(k s) = d/ds / k)."""
     mech = mechanism(name)
     big = scaled(mech, k)
     assert big.size == pytest.approx(k * mech.size, rel=1e-15)
     assert linkage.decompose(big).formula == linkage.decompose(mech).formula
-    ref = linkage.analyze(mech, PHI)
-    out = linkage.analyze(big, PHI)
+    crank = mech.coordinate.is_angle
+    if not crank:
+        assert big.input_range == pytest.approx(tuple(k * v for v in mech.input_range), rel=1e-15)
+    at = positions(mech)
+    ref = linkage.analyze(mech, at)
+    out = linkage.analyze(big, at if crank else k * at)
     points, links, slides = quantities(mech)
+    per = 1.0 if crank else k   # the coordinate scales by this
     tol = 1e-12 * k * mech.size  # 1e-12 relative to the (scaled) size of the mechanism
     for p in points:
         np.testing.assert_allclose(out.point(p), k * ref.point(p), rtol=1e-12, atol=tol, err_msg=p)
         for order, (mine, theirs) in enumerate(zip(out.point_analogs(p), ref.point_analogs(p)), 1):
-            np.testing.assert_allclose(mine, k * theirs, rtol=1e-12, atol=tol, err_msg=p + "'" * order)
+            np.testing.assert_allclose(mine, k * theirs / per**order, rtol=1e-12, atol=tol / per**order,
+                                       err_msg=p + "'" * order)
     for q in links:
         (t, t1, t2), (u, u1, u2) = ref.quantity(q), out.quantity(q)
         np.testing.assert_allclose(wrapped(u - t), 0.0, rtol=0, atol=1e-12, err_msg=q)
-        np.testing.assert_allclose(u1, t1, rtol=1e-12, atol=1e-12, err_msg=q + "'")
-        np.testing.assert_allclose(u2, t2, rtol=1e-12, atol=1e-12, err_msg=q + "''")
+        np.testing.assert_allclose(u1, t1 / per, rtol=1e-12, atol=1e-12 / per, err_msg=q + "'")
+        np.testing.assert_allclose(u2, t2 / per**2, rtol=1e-12, atol=1e-12 / per**2, err_msg=q + "''")
     for q in slides:
         (s, s1, s2), (r, r1, r2) = ref.quantity(q), out.quantity(q)
         np.testing.assert_allclose(r, k * s, rtol=1e-12, atol=tol, err_msg=q)
-        np.testing.assert_allclose(r1, k * s1, rtol=1e-12, atol=tol, err_msg=q + "'")
-        np.testing.assert_allclose(r2, k * s2, rtol=1e-12, atol=tol, err_msg=q + "''")
+        np.testing.assert_allclose(r1, k * s1 / per, rtol=1e-12, atol=tol / per, err_msg=q + "'")
+        np.testing.assert_allclose(r2, k * s2 / per**2, rtol=1e-12, atol=tol / per**2, err_msg=q + "''")

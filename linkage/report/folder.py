@@ -111,6 +111,10 @@ class _Work:
         steps = [self.tables, self.mechanism_pictures, self.kinematic_diagrams, self.force_pictures]
         if self.spec is not None:
             steps += [self.dynamics_tables, self.machine_pictures, self.startup]
+        elif not self.mech.coordinate.is_angle:
+            self.report.notes.append("dynamics: left out (a slide input moves over one stroke, not a cycle: its law "
+                                     f"of motion under an actuator's force is `linkage dynamics {self.mech.name} "
+                                     "--force N`)")
         else:
             self.report.notes.append("dynamics (reduced moments, flywheel, law of motion, start-up): left out "
                                      "(the scheme declares no [dynamics] section)")
@@ -193,9 +197,11 @@ class _Work:
         from .plots import plot_columns
 
         columns = self.forces.columns
-        moment = np.asarray(columns["balancing_moment"], dtype=float)
+        # a crank is balanced by a moment (N m), a slide input by a force (N)
+        load = "moment" if self.mech.coordinate.is_angle else "force"
+        moment = np.asarray(columns[f"balancing_{load}"], dtype=float)
         if not np.any(np.nan_to_num(moment)):
-            self.report.notes.append("balancing moment and hodographs: left out (the scheme declares no loads "
+            self.report.notes.append(f"balancing {load} and hodographs: left out (the scheme declares no loads "
                                      "and no masses: every reaction is zero)")
             return
 
@@ -203,11 +209,12 @@ class _Work:
             import matplotlib.pyplot as plt
 
             fig, ax = plt.subplots(figsize=(7.5, 3.4), layout="constrained")
-            plot_columns(columns, [name for name in columns if name.startswith("balancing_moment")], ax,
+            plot_columns(columns, [name for name in columns if name.startswith(f"balancing_{load}")], ax,
                          mechanism=self.mech)
             return fig
 
-        self._picture("balancing_moment", "Balancing moment on the input link"
+        who = "input link" if load == "moment" else "input slide"
+        self._picture(f"balancing_{load}", f"Balancing {load} on the {who}"
                       + ("s" if len(self.mech.inputs) > 1 else "") + " (kinetostatics at the scheme's speed)",
                       balancing)
         self._picture("hodographs", "Hodographs of the reactions in the main pairs",

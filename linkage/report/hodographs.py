@@ -75,8 +75,13 @@ def main_pairs(mechanism: Mechanism) -> list[str]:
     """
     mech = mechanism
     pairs = list(mech.pairs.values())
+    # the input links; a cylinder (an input that is a pair between two moving links) brings both
+    # of its links, barrel and rod: its own pair and theirs are its "input pairs"
+    inputs: set[str] = set()
+    for name in mech.inputs:
+        inputs |= set(mech.pairs[name].links) - {mech.frame} if name in mech.pairs else {name}
     on_frame = [p.name for p in pairs if mech.frame in p.links]
-    of_input = [p.name for p in pairs if set(p.links) & set(mech.inputs)]
+    of_input = [p.name for p in pairs if set(p.links) & inputs]
     ordered = [n for n in of_input if n in on_frame] + [n for n in of_input if n not in on_frame] + on_frame
     return list(dict.fromkeys(ordered))
 

@@ -148,8 +148,19 @@ def _sub(name: str) -> str:
 
 
 def _input_word(mech: Mechanism | None) -> str:
-    """``"crank"`` (the input turns fully; also when unknown) or ``"input link"`` (a range)."""
-    return "input link" if mech is not None and mech.input_range is not None else "crank"
+    """``"crank"`` (the input turns fully; also when unknown), ``"input link"`` (an angle over a
+    range), ``"input slider"`` (a link driven along a frame guide) or ``"cylinder"`` (a driven
+    prismatic pair between two moving links)."""
+    if mech is None or not mech.inputs:
+        return "crank"
+    if not mech.coordinate.is_angle:
+        return "cylinder" if mech.inputs[0] in mech.pairs else "input slider"
+    return "input link" if mech.input_range is not None else "crank"
+
+
+def _position_name(columns: Mapping[str, Any]) -> str:
+    """The position column of a table: ``phi_deg``, or ``s`` (a slide input, m)."""
+    return "s" if "s" in columns and "phi_deg" not in columns else "phi_deg"
 
 
 def link_role(mech: Mechanism, link: str) -> str:
@@ -187,6 +198,13 @@ _ORDER_WORDS = ("", "velocity analog", "acceleration analog")
 _NAMED = {
     "i": ("position number", "$i$", "position numbers"),
     "phi_deg": ("{crank} angle from the start", r"$\varphi$", "angles"),
+    "s": ("slide of the {crank}", "$s$", "slides"),
+    "balancing_force": ("balancing force on the {crank}", "$F_b$", "forces"),
+    "v": ("speed of the {crank}", "$v$", "speeds"),
+    "a": ("acceleration of the {crank}", "$a$", "accelerations"),
+    "force": ("force of the actuator", "$F$", "forces"),
+    "reduced_force": ("reduced force", "$F_{red}$", "forces"),
+    "reduced_mass": ("reduced mass", "$m_{red}$", "masses"),
     "t": ("time", "$t$", "times"),
     "omega": ("angular velocity of the {crank}", r"$\omega$", "angular velocities"),
     "eps": ("angular acceleration of the {crank}", r"$\varepsilon$", "angular accelerations"),
@@ -199,7 +217,8 @@ _NAMED = {
 }
 
 #: sign conventions the legends repeat (docs/conventions.md)
-_NOTES = {"balancing_moment": "CCW positive", "reduced_moment_resistance": "positive when driving",
+_NOTES = {"balancing_moment": "CCW positive", "balancing_force": "positive along +s",
+          "reduced_moment_resistance": "positive when driving",
           "reduced_moment_driving": "positive when driving"}
 
 
@@ -235,14 +254,19 @@ def describe_column(name: str, mechanism: Mechanism | None = None) -> ColumnWord
     >>> describe_column("3.theta", linkage.load("four_bar")).words
     'angle of rocker 3'
     """
-    unit = unit_for_people(column_unit(name))
+    raw = column_unit(name)
+    if mechanism is not None and mechanism.inputs and not mechanism.coordinate.is_angle:
+        # a slide input: the position is its slide, the analogs are per m of it
+        raw = "m" if name == "s" else raw.replace("/rad", "/m") if raw and "'" in name else raw
+    unit = unit_for_people(raw)
     crank = _input_word(mechanism)
     several = mechanism is not None and len(mechanism.inputs) > 1
     if name in _NAMED:
         words, symbol, kind = _NAMED[name]
         note = _NOTES.get(name, "")
         if several and name == "balancing_moment":      # several inputs: name the first
-            words, symbol = f"balancing moment on {crank} {mechanism.inputs[0]}", f"$M_{{b,{_sub(mechanism.inputs[0])}}}$"
+            first = mechanism.inputs[0]
+            words, symbol = f"balancing moment on {crank} {first}", f"$M_{{b,{_sub(first)}}}$"
         return ColumnWords(name, words.format(crank=crank), symbol, unit, kind, note)
     obj, dot, quantity = name.rpartition(".")
     if obj == "balancing_moment":                       # a further input link's
@@ -319,7 +343,8 @@ def _unwrap(values: np.ndarray, period: float) -> np.ndarray:
 
 
 def extreme_marks(mechanism: Mechanism, phi, quantity: str | None = None) -> list[tuple[float, str]]:
-    """Where the extreme positions of the output lie on a table's ``phi_deg`` axis.
+    """Where the extreme positions of the output lie on a table's ``phi_deg`` axis (on its ``s``
+    axis, m, for a slide input).
 
     Parameters
     ----------
@@ -354,7 +379,12 @@ def extreme_marks(mechanism: Mechanism, phi, quantity: str | None = None) -> lis
     span = abs(phi[-1] - phi[0])
     symbol = describe_column(ext.quantity, mechanism).symbol or ext.quantity
     marks = []
+    slide = not mechanism.coordinate.is_angle
     for at, which in ((ext.phi_max, "max"), (ext.phi_min, "min")):
+        if slide:   # the table's axis is the slide itself, m
+            if min(phi[0], phi[-1]) - 1e-12 <= at <= max(phi[0], phi[-1]) + 1e-12:
+                marks.append((float(at), f"{symbol} {which}"))
+            continue
         d = s * (at - phi[0])
         if mechanism.input_range is None:
             d = np.mod(d, 2 * np.pi)
@@ -379,7 +409,9 @@ def _style_angle_axis(ax, phi: np.ndarray) -> None:
 
     finite = phi[np.isfinite(phi)]
     lo, hi = (float(finite.min()), float(finite.max())) if finite.size else (0.0, 1.0)
-    ax.set_xlim(lo, hi if hi > lo else lo + 1.0)
+    hi = hi if hi > lo else lo + 1.0
+    # a table that runs backwards (a slide decreasing over its stroke): position 1 on the left
+    ax.set_xlim((hi, lo) if finite.size > 1 and finite[0] > finite[-1] else (lo, hi))
     inches = ax.get_position().width * ax.figure.get_figwidth()
     if 180 <= hi - lo <= 400:   # a turn: a tick every 30 deg where there is room for 13 labels
         ax.xaxis.set_major_locator(MultipleLocator(30 if inches >= 4.5 else 60 if inches >= 2.4 else 90))
@@ -474,7 +506,8 @@ def plot_columns(columns: Mapping[str, Any], names: Sequence[str], ax=None, *,
     _pyplot()
     names = list(names)
     missing = [n for n in names if n not in columns]
-    if "phi_deg" not in columns:
+    position = _position_name(columns)
+    if position not in columns:
         missing.insert(0, "phi_deg")
     if missing:
         raise InputError(f"no column {missing[0]!r}; columns: {list(columns)}")
@@ -487,15 +520,15 @@ def plot_columns(columns: Mapping[str, Any], names: Sequence[str], ax=None, *,
                          "plot them with plot_diagrams, one panel per unit")
     if ax is None:
         ax = _new_figure(PAGE_WIDTH, 3.8).add_subplot()
-    phi = np.asarray(columns["phi_deg"], dtype=float)
+    phi = np.asarray(columns[position], dtype=float)
     numbers_col = np.asarray(columns["i"]) if "i" in columns else np.arange(1, len(phi) + 1)
     ms = 5 if len(phi) <= 40 else 3.5
     for k, (name, d) in enumerate(zip(names, described)):
         colour, marker = CURVE_COLOURS[k % len(CURVE_COLOURS)], MARKERS[k % len(MARKERS)]
         values = np.asarray(columns[name], dtype=float)
         period = _is_angle(name)
-        if fine is not None and name in fine and "phi_deg" in fine:
-            fphi = np.asarray(fine["phi_deg"], dtype=float)
+        if fine is not None and name in fine and position in fine:
+            fphi = np.asarray(fine[position], dtype=float)
             fvalues = np.asarray(fine[name], dtype=float)
             if period:
                 fvalues = _unwrap(fvalues, period)
@@ -524,11 +557,11 @@ def plot_columns(columns: Mapping[str, Any], names: Sequence[str], ax=None, *,
         x_lo, x_hi = ax.get_xlim()
     for x, text in marks:
         ax.axvline(x, color="0.25", ls="-.", lw=1.0, gid="extreme-position")
-        right = x > x_lo + 0.85 * (x_hi - x_lo)
+        right = (x - x_lo) / (x_hi - x_lo) > 0.85    # (an axis may run backwards)
         ax.annotate(text, (x, 1.0), xycoords=("data", "axes fraction"), xytext=(-3 if right else 3, -2),
                     textcoords="offset points", ha="right" if right else "left", va="top", fontsize=SMALL,
                     gid="extreme-position-text")
-    ax.set_xlabel(describe_column("phi_deg", mechanism).axis, fontsize=FONT)
+    ax.set_xlabel(describe_column(position, mechanism).axis, fontsize=FONT)
     ax.set_ylabel(_wrapped(_panel_label(described), ax), fontsize=FONT)
     if legend or (legend is None and entries > 1):
         ax.legend(fontsize=SMALL, loc="best", framealpha=0.9)
@@ -853,7 +886,7 @@ class _Geometry:
                 raise InputError(f"no point {name!r} to draw the trajectory of; points: {mech.point_names}")
         for i in positions:
             if not np.all([np.all(np.isfinite(motion.poses[k][i])) for k in motion.poses]):
-                raise InputError(f"position {i + 1} (phi = {np.degrees(motion.phi[i]):.6g} deg) is not assembled: "
+                raise InputError(f"position {i + 1} ({mech.coordinate.describe([motion.phi[i]])}) is not assembled: "
                                  "nothing to draw")
         # the scale of the drawing: the points at the drawn positions and the sliders' travel
         pts = [self._all_points(i) for i in positions]
@@ -867,7 +900,8 @@ class _Geometry:
 
     def _all_points(self, i: int) -> np.ndarray:
         m = self.motion
-        return np.array([_global(m, lk, local, slice(i, i + 1))[0] for lk in m.poses
+        # the links placed (a cylinder's driver "K.s" has a pose but is no link: no points)
+        return np.array([_global(m, lk, local, slice(i, i + 1))[0] for lk in m.poses if lk in self.mech.links
                          for local in self.mech.links[lk].points.values()] +
                         [np.asarray(p) for p in self.mech.links[self.mech.frame].points.values()]).reshape(-1, 2)
 
@@ -1101,11 +1135,11 @@ def _block_size(u: float, on_frame: bool) -> tuple[float, float]:
 def _caption(motion, i: int, trajectories: Sequence[str] = (), compact: bool = False) -> str:
     """The position number and the input angle in words (and what the dashed lines are), in lines
     that fit above a drawing: :data:`CAPTION_CHARS` (:data:`COMPACT_CHARS` for a panel of a grid)."""
-    import textwrap
-
     from ..kinematics import table_positions_deg
 
     mech = motion.mechanism
+    if not mech.coordinate.is_angle:
+        return _wrapped_caption(mech, _slide_phrases(motion, i, compact), trajectories, compact)
     direction = motion.direction
     turned = float(table_positions_deg(motion.phi, direction)[i])
     sense = "counter-clockwise" if direction > 0 else "clockwise"
@@ -1120,6 +1154,31 @@ def _caption(motion, i: int, trajectories: Sequence[str] = (), compact: bool = F
         phrases = [f"{head}:", f"the {who} at {at}"]
     else:
         phrases = [f"{head}:", f"the {who} turned {turned:.4g}°", sense, "from position 1", f"({at})"]
+    return _wrapped_caption(mech, phrases, trajectories, compact)
+
+
+def _slide_phrases(motion, i: int, compact: bool) -> list[str]:
+    """The phrases of a caption for a slide input: how far it moved from position 1, and where."""
+    mech = motion.mechanism
+    who = _input_word(mech)
+    s0, s = float(motion.phi[0]), float(motion.phi[i])
+    of = f" of {len(motion.phi)}" if len(motion.phi) > 1 else ""
+    head = f"Position {i + 1}{of}"
+    at = f"s = {s:.4g} m"
+    if i == 0 or len(motion.phi) == 1:
+        return [f"{head}:", f"the {who} at {at}"]
+    moved = s - s0
+    if who == "cylinder":
+        verb = "extended" if moved >= 0 else "retracted"
+        return [f"{head}:", f"the {who} {verb} by {abs(moved):.4g} m", "from position 1", f"({at})"]
+    return [f"{head}:", f"the {who} moved {abs(moved):.4g} m", "towards +s" if moved >= 0 else "towards −s",
+            "from position 1", f"({at})"]
+
+
+def _wrapped_caption(mech, phrases: list[str], trajectories: Sequence[str], compact: bool) -> str:
+    """Whole phrases to a line while they fit, then what the dashed lines are."""
+    import textwrap
+
     width = COMPACT_CHARS if compact else CAPTION_CHARS
     lines = [""]
     for phrase in phrases:   # whole phrases to a line while they fit
@@ -1306,9 +1365,10 @@ def draw_positions(motion, positions: Sequence[int] | None = None, *, ncols: int
     compact = ncols > 1
     texts = [_caption(motion, i, compact=compact) for i in idx]
     lines = max(t.count("\n") + 1 for t in texts)
-    who = "input link" if motion.mechanism.input_range is not None else "crank"
-    header = [f"{motion.mechanism.name} at {len(idx)} positions, one scale"
-              + (f"; φ: the {who}'s angle from the x axis" if compact else "")]
+    who = _input_word(motion.mechanism)
+    what = (f"; φ: the {who}'s angle from the x axis" if motion.mechanism.coordinate.is_angle else
+            f"; s: the {who}'s slide, m")
+    header = [f"{motion.mechanism.name} at {len(idx)} positions, one scale" + (what if compact else "")]
     if trajectories:
         header.append(_trajectory_note(motion.mechanism, trajectories))
     chars = max(len(line) for line in texts[0].splitlines() + header)

@@ -21,7 +21,7 @@ import numpy as np
 from ..dynamics import DynamicsReport, run_dynamics
 from ..errors import InputError
 from ..extremes import table_angles
-from ..kinematics import Motion, analyze, structure_of, table_positions_deg
+from ..kinematics import Motion, analyze, position_column, structure_of, table_positions_deg
 from ..model import Mechanism
 from ..scheme import section_of
 from .tables import format_columns, units_of
@@ -127,12 +127,18 @@ def table_positions(mech: Mechanism, n: int, start: str | float | InputRange, di
     """Input angles of a table (rad) and the start actually used ("range" over an input range:
     an :class:`InputRange`, else the scheme's range_deg); what was assumed is appended to
     ``notes``."""
+    if not mech.coordinate.is_angle and isinstance(start, InputRange):
+        raise InputError(f"{start!r}: scheme '{mech.name}' is driven by a slide (input '{mech.inputs[0]}'), "
+                         "analysed over the stroke it declares (range = [s_start, s_end] in m); --range A B "
+                         "gives input angles (deg) for a crank")
     if isinstance(start, InputRange) or mech.input_range is not None:
         if not (start is None or start == "extreme" or isinstance(start, InputRange)):
-            a, b = np.degrees(mech.input_range)
-            raise InputError(f"scheme '{mech.name}' declares range_deg = [{a:.10g}, {b:.10g}], which fixes "
-                             f"position 1 at {a:.10g} deg: --start {start} applies to a full turn (choose "
-                             "another range with --range A B)")
+            other = ("choose another range with --range A B" if mech.coordinate.is_angle else
+                     "a slide input is analysed over its stroke: declare another one with range = [s_start, s_end] "
+                     "in the scheme")
+            raise InputError(f"scheme '{mech.name}' declares {declared_range(mech)}, which fixes position 1 at "
+                             f"{_shown(mech, mech.input_range[0])}: --start {start} applies to a full turn of a "
+                             f"crank ({other})")
         span = start.span if isinstance(start, InputRange) else None
         return table_angles(mech, n, "extreme", direction, span=span), "range"
     if isinstance(start, str) and mech.output is None:
@@ -148,6 +154,26 @@ def table_positions(mech: Mechanism, n: int, start: str | float | InputRange, di
         raise
 
 
+def declared_range(mech: Mechanism) -> str:
+    """The scheme's input range as it is written: ``range_deg = [a, b]`` for a crank's angles
+    (deg), ``range = [a, b] m`` for a slide input's stroke."""
+    a, b = mech.coordinate.shown(mech.input_range)
+    return f"range_deg = [{a:.10g}, {b:.10g}]" if mech.coordinate.is_angle else f"range = [{a:.10g}, {b:.10g}] m"
+
+
+def _shown(mech: Mechanism, value: float) -> str:
+    """One value of the input coordinate with its unit: ``27.5 deg`` or ``0.48 m``."""
+    return f"{float(mech.coordinate.shown(value)):.10g} {mech.coordinate.shown_unit}"
+
+
+def start_meta(mech: Mechanism, phi: np.ndarray) -> dict[str, float]:
+    """The position-1 entry of a JSON document: ``phi0_deg`` (the input angle, deg) for a crank,
+    ``s0`` (the input slide, m) for a slide input."""
+    if mech.coordinate.is_angle:
+        return {"phi0_deg": float(np.degrees(phi[0]))}
+    return {"s0": float(phi[0])}
+
+
 def table_sense(phi: np.ndarray) -> int:
     """+1 / -1: the sense in which a table's input angles run (``phi = phi0 + direction * phi_deg``)."""
     return -1 if len(phi) > 1 and phi[-1] < phi[0] else 1
@@ -161,8 +187,12 @@ def failures(motion: Motion) -> tuple[list[dict], list[str]]:
     from assur.base import CANNOT_ASSEMBLE, NOT_CONVERGED, SINGULAR
 
     failed, lines = [], []
-    travelled = table_positions_deg(motion.phi)
-    phi_deg = np.degrees(motion.phi)
+    mech = motion.mechanism
+    angle = mech.coordinate.is_angle
+    column = position_column(mech)
+    travelled = table_positions_deg(motion.phi) if angle else np.asarray(motion.phi, float)
+    phi_deg = np.degrees(motion.phi) if angle else np.asarray(motion.phi, float)
+    where_words = "input angle phi = {} deg" if angle else "input slide s = {} m"
     for code, what, blank in ((CANNOT_ASSEMBLE, "cannot be assembled", "values are empty (nan)"),
                               (SINGULAR, "is singular", "analogs are empty (nan)"),
                               (NOT_CONVERGED, "was not solved: Newton's method did not converge",
@@ -173,10 +203,12 @@ def failures(motion: Motion) -> tuple[list[dict], list[str]]:
         numbers = ", ".join(str(i + 1) for i in where)
         shown = ", ".join(f"{phi_deg[i]:.6g}" for i in where)
         lines.append(f"mechanism '{motion.mechanism.name}' {what} at positions i = {numbers} "
-                     f"(input angle phi = {shown} deg): {blank} in those rows")
+                     f"({where_words.format(shown)}): {blank} in those rows")
         for i in where:
-            entry = {"position": int(i) + 1, "phi_deg": float(travelled[i]),
-                     "input_angle_deg": float(phi_deg[i]), "problem": what}
+            entry = {"position": int(i) + 1, column: float(travelled[i])}
+            if angle:
+                entry["input_angle_deg"] = float(phi_deg[i])
+            entry["problem"] = what
             if code == SINGULAR:  # the least conditioned group: its distance to the singularity
                 worst = min(motion.conditioning.items(), key=lambda kv: np.nan_to_num(kv[1][i], nan=2.0))
                 entry.update(group=worst[0], conditioning=float(worst[1][i]))
@@ -214,7 +246,7 @@ def kinematics_results(mech: Mechanism, positions: int | None = None,
         columns = motion.columns()
     failed, lines = failures(motion)
     meta = {"scheme": mech.name, "description": mech.description, "formula": structure_of(mech).formula,
-            "positions": n, "start": start, "phi0_deg": float(np.degrees(phi[0])), "direction": table_sense(phi),
+            "positions": n, "start": start, **start_meta(mech, phi), "direction": table_sense(phi),
             "failed": failed}
     return TableResults(columns, meta, motion, notes, lines + _caught(caught, failed))
 
@@ -246,7 +278,7 @@ def forces_results(mech: Mechanism, positions: int | None = None, start: str | f
     failed, lines = failures(motion)
     notes += list(reactions.notes)
     meta = {"scheme": mech.name, "formula": structure_of(mech).formula, "omega": omega, "eps": eps,
-            "positions": n, "start": start, "phi0_deg": float(np.degrees(phi[0])), "direction": table_sense(phi),
+            "positions": n, "start": start, **start_meta(mech, phi), "direction": table_sense(phi),
             "convention": REACTION_CONVENTION,
             "virtual_power_residual_max": float(np.nanmax(residual)) if np.isfinite(residual).any() else None,
             "failed": failed, "notes": list(reactions.notes)}
