@@ -650,7 +650,7 @@ def test_dead_centre_is_singular_not_silently_wrong():
 
 
 @pytest.mark.parametrize("k", [1e-3, 1e3])
-@pytest.mark.parametrize("scheme", ["piston", "cylinder"])
+@pytest.mark.parametrize("scheme", ["piston"])    # the cylinder: tests/test_structure.py::test_scale_invariance
 def test_scale_invariance(scheme, k):
     text, closed, s = (piston_text, piston_closed, S_PISTON) if scheme == "piston" else \
         (cylinder_text, cylinder_closed, S_CYL)

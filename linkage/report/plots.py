@@ -254,11 +254,8 @@ def describe_column(name: str, mechanism: Mechanism | None = None) -> ColumnWord
     >>> describe_column("3.theta", linkage.load("four_bar")).words
     'angle of rocker 3'
     """
-    raw = column_unit(name)
-    if mechanism is not None and mechanism.inputs and not mechanism.coordinate.is_angle:
-        # a slide input: the position is its slide, the analogs are per m of it
-        raw = "m" if name == "s" else raw.replace("/rad", "/m") if raw and "'" in name else raw
-    unit = unit_for_people(raw)
+    per = mechanism.coordinate.unit if mechanism is not None and mechanism.inputs else "rad"
+    unit = unit_for_people(column_unit(name, per))
     crank = _input_word(mechanism)
     several = mechanism is not None and len(mechanism.inputs) > 1
     if name in _NAMED:

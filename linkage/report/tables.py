@@ -223,8 +223,10 @@ _QUANTITY_UNITS = {
 }
 
 
-def column_unit(name: str) -> str | None:
-    """The unit of a table column, from its name (None: a count or a pure number).
+def column_unit(name: str, per: str = "rad") -> str | None:
+    """The unit of a table column, from its name (None: a count or a pure number). ``per``: the
+    unit of the first input's coordinate, which the analogs are per (``"m"`` for a slide input:
+    ``B.x'`` m/m, ``3.theta''`` rad/m^2, and the position column ``s`` is in m).
 
     ``i`` none; ``*_deg`` deg; ``P.x P.y K.s`` m (with ``'`` m/rad, ``''`` m/rad^2);
     ``L.theta`` rad (rad/rad, rad/rad^2); ``K.R K.Rx K.Ry`` N; ``K.M`` N m; ``balancing_moment``
@@ -236,6 +238,8 @@ def column_unit(name: str) -> str | None:
     """
     if name.endswith("_deg"):
         return "deg"
+    if name == "s" and per == "m":
+        return "m"
     if name in _NAMED_UNITS:
         return _NAMED_UNITS[name]
     if name.startswith("balancing_moment."):      # a further input link's balancing moment
@@ -248,18 +252,16 @@ def column_unit(name: str) -> str | None:
     base = quantity.rstrip("'")
     order = len(quantity) - len(base)
     units = _QUANTITY_UNITS.get(base, ())
-    return units[order] if order < len(units) else None
+    unit = units[order] if order < len(units) else None
+    return unit.replace("/rad", f"/{per}") if unit and order else unit
 
 
 def units_of(columns: Iterable[str]) -> dict[str, str | None]:
-    """``{name: column_unit(name)}`` for the given column names. In a table whose position column
-    is a slide ``s`` (m, a slide input), analogs are per m: ``B.x'`` m/m, ``3.theta''`` rad/m^2."""
+    """``{name: column_unit(name, per)}`` for the given column names; a table whose position column
+    is a slide ``s`` (m, a slide input) has its analogs per m."""
     columns = list(columns)
-    units = {name: column_unit(name) for name in columns}
-    if "s" in columns:
-        units = {name: u.replace("/rad", "/m") if u and "'" in name else u for name, u in units.items()}
-        units["s"] = "m"
-    return units
+    per = "m" if "s" in columns else "rad"
+    return {name: column_unit(name, per) for name in columns}
 
 
 # ----------------------------------------------------------------------------------------------
