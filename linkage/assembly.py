@@ -364,7 +364,7 @@ def _traced_plan(mech, structure, plans, i, rule, poses, phi) -> BranchPlan:
             trial = {**poses, **trace.rows}
             score = _rule_score(mech, rule, trial)
             if rule.phi is not None:
-                near = int(np.argmin([_apart(x, rule.phi, mech) for x in phi]))
+                near = int(np.argmin(_apart(phi, rule.phi, mech)))
                 score = score[near:near + 1]
             with np.errstate(invalid="ignore"):
                 scores.append(int(np.sum(score > 1e-9 * mech.size)))
@@ -707,9 +707,10 @@ def _fold(x: float, mech) -> float:
     return x % TWO_PI if mech.coordinate.is_angle else float(x)
 
 
-def _apart(a: float, b: float, mech) -> float:
-    """How far apart two input coordinates are (angles: modulo a turn)."""
-    return abs((a - b + np.pi) % TWO_PI - np.pi) if mech.coordinate.is_angle else abs(a - b)
+def _apart(a, b, mech):
+    """How far apart input coordinates are (angles: modulo a turn); elementwise on arrays."""
+    gap = np.subtract(a, b)
+    return np.abs((gap + np.pi) % TWO_PI - np.pi if mech.coordinate.is_angle else gap)
 
 
 def _conditioning_minima(mech, phi, r, measure) -> list[float]:

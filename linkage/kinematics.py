@@ -22,7 +22,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from assur.base import (ANALOG_TOL, CANNOT_ASSEMBLE, OK, SINGULAR, DrivenPrismaticJoint, global_point,
-                        point_analogs)
+                        point_analogs, rotate)
 from assur.rows import frame, xy
 
 from .assembly import assembly_branches, assembly_plans, place_group
@@ -558,22 +558,16 @@ def _slider_state(joint, link: str, s, rate, accel, pose, first, second) -> None
     if joint.b == link:             # guide on the frame: r = g + s u - Rot(beta) p
         theta, sign = joint.beta, 1.0
         u = np.asarray(joint.u, float)
-        start = np.asarray(joint.g, float) - _turned(theta, joint.p)
+        start = np.asarray(joint.g, float) - rotate(theta, joint.p)
     else:                           # guide on the link: r = p - Rot(-beta) g - s u
         theta, sign = -joint.beta, -1.0
-        u = _turned(theta, joint.u)
-        start = np.asarray(joint.p, float) - _turned(theta, joint.g)
+        u = rotate(theta, joint.u)
+        start = np.asarray(joint.p, float) - rotate(theta, joint.g)
     along = sign * np.asarray(s, float)
     pose[:, 0], pose[:, 1], pose[:, 2] = start[0] + along * u[0], start[1] + along * u[1], theta
     for analogs, value in ((first, rate), (second, accel)):
         if analogs is not None:
             analogs[:, 0], analogs[:, 1], analogs[:, 2] = sign * value * u[0], sign * value * u[1], 0.0
-
-
-def _turned(theta: float, p) -> np.ndarray:
-    """``Rot(theta) p`` for one angle and one local vector ``(2,)``."""
-    c, s = np.cos(theta), np.sin(theta)
-    return np.array([c * p[0] - s * p[1], s * p[0] + c * p[1]])
 
 
 def input_angles(mech: Mechanism, structure: Structure, phi: np.ndarray) -> dict[str, tuple]:

@@ -28,6 +28,7 @@ from typing import Callable
 import numpy as np
 from scipy.integrate import cumulative_trapezoid
 
+from .dynamics import _eps, _pick
 from .errors import DynamicsError, DynamicsInputError
 from .kinematics import analyze
 from .kinetostatics import Reactions, solve_reactions
@@ -143,8 +144,7 @@ def stroke_motion(mech: Mechanism, force: float | Callable[[np.ndarray], np.ndar
     with np.errstate(divide="ignore"):
         steps = np.where(w[:-1] + w[1:] > 0, 2 * abs(s[1] - s[0]) / (w[:-1] + w[1:]), np.inf)
     t = np.concatenate([[0.0], np.cumsum(steps)])
-    accel = sense * (along - 0.5 * reduced.inertia_derivative * w**2) / reduced.inertia
+    accel = _eps(reduced, sense * pushed, reduced.inertia, w)      # the crank's formula, per m
     keep = slice(None, None, SUBSTEPS)
-    table = Reduced(s[keep], sense, reduced.moment_resistance[keep], reduced.moment_driving[keep],
-                    reduced.inertia_constant, reduced.inertia_variable[keep], reduced.inertia_derivative[keep])
-    return StrokeMotion(mech, s[keep], t[keep], sense * w[keep], accel[keep], pushed[keep].copy(), table)
+    return StrokeMotion(mech, s[keep], t[keep], sense * w[keep], accel[keep], pushed[keep].copy(),
+                        _pick(reduced, keep))
