@@ -3,8 +3,17 @@
 See :mod:`assur.base` for the group protocol every kind implements.
 """
 
-from .base import (ANALOG_TOL, CANNOT_ASSEMBLE, NOT_CONVERGED, OK, SINGULAR, SINGULAR_TOL, Group, PrismaticJoint,
-                   RevoluteJoint)
+from .base import (
+                   ANALOG_TOL,
+                   CANNOT_ASSEMBLE,
+                   NOT_CONVERGED,
+                   OK,
+                   SINGULAR,
+                   SINGULAR_TOL,
+                   Group,
+                   PrismaticJoint,
+                   RevoluteJoint,
+)
 from .registry import GROUP_KINDS, group_kind, register, solver_for
 
 __all__ = [

@@ -28,7 +28,7 @@ The public template methods :meth:`Group.position`, :meth:`Group.analogs` and
 size) and the shared linear algebra (constraint Jacobian for analogs, its transpose for
 reactions). Status codes per position: ``OK = 0``, ``CANNOT_ASSEMBLE = -1``, ``SINGULAR = -2``,
 ``NOT_CONVERGED = -4`` (a group solved by Newton's method was given a start but did not reach a
-closed position from it; -3 is a batch's ``linkage.batch.OTHER_BRANCH``).
+closed position from it; -3 is a batch's ``linkage.kinematics.batch.OTHER_BRANCH``).
 """
 
 from __future__ import annotations

@@ -12,8 +12,19 @@ from typing import ClassVar
 
 import numpy as np
 
-from .base import (ANALOG_TOL, CANNOT_ASSEMBLE, CLOSURE_TOL, COINCIDENT, OK, SINGULAR, Group, GroupSolution, Joint,
-                   PrismaticJoint, error_bound)
+from .base import (
+    ANALOG_TOL,
+    CANNOT_ASSEMBLE,
+    CLOSURE_TOL,
+    COINCIDENT,
+    OK,
+    SINGULAR,
+    Group,
+    GroupSolution,
+    Joint,
+    PrismaticJoint,
+    error_bound,
+)
 from .rows import arm, frame, rows_of, xy
 
 __all__ = ["Dyad"]

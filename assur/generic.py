@@ -4,7 +4,7 @@ A group that no closed-form kind binds -- a class-III triad, a class-IV group, a
 prismatic pairs in any arrangement -- is solved by Newton's method on its constraint equations
 ``Phi(q) = 0`` with the analytic Jacobian the group protocol builds (:meth:`Group.jacobians`),
 started from a *start*: poses of the group's links near the wanted solution. The start comes from
-the group's assembly plan (:mod:`linkage.assembly`): the chosen assembly mode, traced over a sweep
+the group's assembly plan (:mod:`linkage.kinematics.assembly`): the chosen assembly mode, traced over a sweep
 of the input angle by continuation, interpolated at each analysed angle; Newton only polishes it.
 Everything else -- the closure and singularity checks, the exact analogs, the kinetostatics -- is
 the shared generic path of :class:`assur.base.Group`.

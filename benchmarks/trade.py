@@ -47,10 +47,10 @@ if str(ROOT) not in sys.path:  # run as a script from a checkout
 import linkage
 from assur import Group
 from assur.dyad import Dyad
-from linkage.dynamics import course_method, dynamics_of, exact_method, steady_state
+from linkage.dynamics.pipeline import course_method, dynamics_of, exact_method, steady_state
 from linkage.errors import AssemblyError, LinkageError, SchemeError
-from linkage.kinematics import BranchWarning
-from linkage.reduced import reduced_characteristics
+from linkage.kinematics.motion import BranchWarning
+from linkage.dynamics.reduced import reduced_characteristics
 
 __all__ = [
     "AnalogRow",
@@ -242,7 +242,7 @@ class PositionsRow:
     n : int
         Table positions per revolution.
     seconds : float
-        Wall time of :func:`linkage.dynamics.course_method`, s.
+        Wall time of :func:`linkage.dynamics.pipeline.course_method`, s.
     work : float
         Cycle work of the resisting forces (gravity included), trapezoid on the n steps, J.
     driving : float
@@ -585,7 +585,7 @@ class MethodsResult:
 
     ``laws`` maps ``"course"``, ``"exact"``, ``"ode_course"`` (the steady state of the equation of
     motion with the course method's flywheel) and ``"ode_exact"`` (with the exact one) to
-    :class:`linkage.dynamics.LawOfMotion` at ``fine`` positions (the course method at its declared n),
+    :class:`linkage.dynamics.pipeline.LawOfMotion` at ``fine`` positions (the course method at its declared n),
     ``seconds`` to the wall time of each (s); ``n`` is the declared number of positions and
     ``stride`` picks them out of the ``fine`` ones.
     """

@@ -10,7 +10,7 @@ from pathlib import Path
 
 
 import linkage
-from linkage.dynamics import run_dynamics
+from linkage.dynamics.pipeline import run_dynamics
 
 mech = linkage.load("course_slider_crank")
 print(linkage.structure_of(mech).formula)

@@ -10,8 +10,8 @@ from pathlib import Path
 import numpy as np
 
 import linkage
-from linkage.forces import Loads, PointForce
-from linkage.kinetostatics import solve_reactions, virtual_power_residual
+from linkage.kinetostatics.loads import Loads, PointForce
+from linkage.kinetostatics.reactions import solve_reactions, virtual_power_residual
 
 b = linkage.MechanismBuilder("lever_press")
 b.link("0", points={"O": (0.0, 0.15), "Q": (0.0, 0.0)},

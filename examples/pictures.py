@@ -17,7 +17,7 @@ import sys
 from pathlib import Path
 
 import linkage
-from linkage.dynamics import run_dynamics
+from linkage.dynamics.pipeline import run_dynamics
 
 try:
     import matplotlib

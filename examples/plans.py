@@ -16,8 +16,8 @@ from pathlib import Path
 import numpy as np
 
 import linkage
-from linkage.kinetostatics import solve_reactions
-from linkage.plans import build_plans
+from linkage.kinetostatics.reactions import solve_reactions
+from linkage.kinetostatics.plans import build_plans
 
 POSITION = 12                                         # the table's row number, 1 .. 13
 mech = linkage.load("course_slider_crank")            # clockwise at 10.472 rad/s, 12 steps

@@ -22,8 +22,8 @@ except ReportExtraMissing as exc:
     sys.exit(0)
 
 from linkage.report.folder import write_report  # noqa: E402
-from linkage.template import load_template  # noqa: E402
-from linkage.variants import select_variants, write_variants  # noqa: E402
+from linkage.course.template import load_template  # noqa: E402
+from linkage.course.variants import select_variants, write_variants  # noqa: E402
 
 out = Path(sys.argv[1] if len(sys.argv) > 1 else "out")
 

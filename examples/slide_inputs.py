@@ -17,9 +17,9 @@ from pathlib import Path
 import numpy as np
 
 import linkage
-from linkage.kinematics import angle_in_half_turn
-from linkage.kinetostatics import solve_reactions
-from linkage.stroke import stroke_motion
+from linkage.kinematics.motion import angle_in_half_turn
+from linkage.kinetostatics.reactions import solve_reactions
+from linkage.dynamics.stroke import stroke_motion
 
 for name, speed in (("piston_driven_crank", -2.0), ("cylinder_boom", 0.2)):
     mech = linkage.load(name)

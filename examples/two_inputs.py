@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 import linkage
-from linkage.kinetostatics import solve_reactions
+from linkage.kinetostatics.reactions import solve_reactions
 
 mech = linkage.load("five_bar_two_input")
 phi = np.radians(np.arange(0.0, 361.0, 2.0))     # a closed turn: the last angle repeats the first

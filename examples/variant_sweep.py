@@ -3,7 +3,7 @@
 Varies the crank OA and the rocker CB of the shipped four-bar, analyses every variant with
 ``linkage.analyze_variants`` and prints, for the best variants, the rocker's swing, the
 smallest transmission angle and the peak balancing moment at 10 rad/s (the reactions of all
-variants in one more call, ``linkage.batch_reactions.variant_reactions``, with the rocker's mass
+variants in one more call, ``linkage.kinetostatics.batch.variant_reactions``, with the rocker's mass
 scaled with its length), and draws the swing over the two dimensions into
 ``OUT/variant_sweep.png`` (matplotlib, the ``plot`` extra). Run: ``python examples/variant_sweep.py [OUT]``.
 """
@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 import linkage
-from linkage.batch_reactions import variant_reactions
+from linkage.kinetostatics.batch import variant_reactions
 
 mech = linkage.load("four_bar")                 # O-A-B-C: OA = 0.1, AB = 0.3, CB = 0.25, OC = 0.3
 crank, rocker = np.meshgrid(np.linspace(0.06, 0.14, 50), np.linspace(0.18, 0.32, 40), indexing="ij")

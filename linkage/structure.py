@@ -1,6 +1,6 @@
 """Structural analysis: mobility (Chebyshev) and decomposition into Assur groups (docs/methods.md#structure).
 
-Plain functions on a :class:`~linkage.model.Mechanism`:
+Plain functions on a :class:`~linkage.model.mechanism.Mechanism`:
 
 >>> import linkage
 >>> mech = linkage.load("slider_crank")
@@ -19,9 +19,9 @@ from assur import Group, PrismaticJoint, RevoluteJoint, solver_for
 from assur.base import DrivenPrismaticJoint
 
 from .errors import StructureError
-from .model import Mechanism, Prismatic, Revolute
+from .model.mechanism import Mechanism, Prismatic, Revolute
 
-__all__ = ["Structure", "mobility", "decompose", "joint_of"]
+__all__ = ["Structure", "mobility", "decompose", "structure_of", "joint_of"]
 
 #: largest group size searched (class III groups have 4 links)
 MAX_GROUP_LINKS = 4
@@ -109,6 +109,13 @@ def joint_of(pair: Revolute | Prismatic, mech: Mechanism) -> RevoluteJoint | Pri
     # the slider's x axis runs along the guide, turned by the pair's angle
     return PrismaticJoint(pair.name, a, b, guide.point, guide.direction, lb.points[pair.point],
                           guide.angle + pair.angle)
+
+
+def structure_of(mech: Mechanism) -> Structure:
+    """The decomposition of ``mech`` (:func:`decompose`), computed once and kept in its cache."""
+    if "structure" not in mech.cache:
+        mech.cache["structure"] = decompose(mech)
+    return mech.cache["structure"]
 
 
 def decompose(mech: Mechanism) -> Structure:

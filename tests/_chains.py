@@ -5,7 +5,7 @@ turns it into a *design* (:class:`Chain`) the way a designer would: the mechanis
 reference configuration (crank at ``phi0``) in global coordinates, every link gets a local frame,
 and lengths, guide positions, pair angles and assembly branches are read off that drawing, so the
 reference configuration is a known solution on a known branch. :func:`build` declares the design
-through :class:`linkage.model.MechanismBuilder` (in any declaration order); :func:`oracle` solves
+through :class:`linkage.model.mechanism.MechanismBuilder` (in any declaration order); :func:`oracle` solves
 the same design over input angles with closed forms written here (circle-circle, circle-line,
 line-line and 2x2 linear intersections), independent of :mod:`assur`, and returns each group's
 conditioning at its own scale (a nondimensional sine per kind, see :func:`oracle`).
@@ -34,8 +34,8 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from linkage.forces import LinkMoment, Loads, PointForce
-from linkage.model import MechanismBuilder
+from linkage.kinetostatics.loads import LinkMoment, Loads, PointForce
+from linkage.model.mechanism import MechanismBuilder
 
 __all__ = ["KINDS", "DyadShape", "ChainShape", "Chain", "realize", "build", "oracle", "loads_of",
            "rot", "gpt", "wrap", "cross", "dot", "direction", "norm", "extent"]

@@ -175,7 +175,7 @@ def test_each_frame_draws_what_draw_mechanism_draws_at_that_angle(name):
             kind, _, what = gid.partition(":")
             if kind == "point":
                 assert artist.center == pytest.approx(single.point(what)[0], abs=1e-12)
-            elif kind == "pair" and not isinstance(mech.pairs[what], linkage.model.Prismatic):
+            elif kind == "pair" and not isinstance(mech.pairs[what], linkage.model.mechanism.Prismatic):
                 assert artist.center == pytest.approx(single.point(mech.pairs[what].point)[0], abs=1e-12)
         for point in film.trajectories:                              # the trajectories whole, as drawn alone
             mine = next(line for line in film.ax.lines if line.get_gid() == f"trajectory:{point}")

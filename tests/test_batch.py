@@ -12,9 +12,9 @@ import numpy as np
 import pytest
 
 import linkage
-from linkage.batch import OTHER_BRANCH, analyze_variants, geometry_of
+from linkage.kinematics.batch import OTHER_BRANCH, analyze_variants, geometry_of
 from linkage.errors import InputError
-from linkage.kinematics import BranchWarning
+from linkage.kinematics.motion import BranchWarning
 
 SCHEMES = Path(__file__).resolve().parent.parent / "schemes"
 PHI = np.radians(np.arange(0.0, 360.0, 30.0))

@@ -1,4 +1,4 @@
-"""Kinetostatics of a batch of variants (``linkage.batch_reactions.variant_reactions``): each
+"""Kinetostatics of a batch of variants (``linkage.kinetostatics.batch.variant_reactions``): each
 variant's reactions equal its own scheme text (masses and a force written into it) solved alone;
 a slider-crank's balancing moment equals the closed form of virtual work; the virtual-power check
 holds at every OK position; bad input is refused with the entry named."""
@@ -16,10 +16,10 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from test_batch import PHI, SCHEMES, four_bar_geometry, four_bar_text  # noqa: E402
 
 import linkage  # noqa: E402
-from linkage.batch import analyze_variants  # noqa: E402
-from linkage.batch_reactions import variant_reactions  # noqa: E402
+from linkage.kinematics.batch import analyze_variants  # noqa: E402
+from linkage.kinetostatics.batch import variant_reactions  # noqa: E402
 from linkage.errors import InputError  # noqa: E402
-from linkage.kinetostatics import solve_reactions  # noqa: E402
+from linkage.kinetostatics.reactions import solve_reactions  # noqa: E402
 
 
 def with_masses_and_force(text: str, coupler_mass: float, rocker_inertia: float, force: tuple[float, float]) -> str:

@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 
 import linkage
-from linkage.assembly import assembly_plans
-from linkage.kinematics import BranchWarning
+from linkage.kinematics.assembly import assembly_plans
+from linkage.kinematics.motion import BranchWarning
 
 from _texts import four_bar_toml, slider_crank_toml
 
@@ -186,8 +186,8 @@ def test_a_condition_that_holds_on_neither_candidate_at_its_angle_is_refused():
 def test_a_jump_the_change_point_search_missed_is_still_reported():
     """Safety net: with the change point hidden from the plan, the deltoid's 4 m jump between two
     analysed angles 1 deg apart is reported by comparing the motion with its analogs."""
-    from linkage.assembly import BranchPlan
-    from linkage.kinematics import _cache
+    from linkage.kinematics.assembly import BranchPlan
+    from linkage.kinematics.motion import _cache
 
     mech = linkage.loads(four_bar(1, 2, 2, 1, 'left_of = ["A", "C"]'))
     _cache(mech)["plans"] = (BranchPlan(1, "keep", np.empty(0), np.empty(0, bool)),)

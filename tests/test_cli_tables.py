@@ -171,7 +171,7 @@ def test_default_tables_of_every_shipped_scheme_fit_in_160_characters(capsys, co
         body = table_lines(out)
         assert max(len(ln) for ln in body) <= 160, (scheme, max(len(ln) for ln in body))
         table = read_table(out)
-        assert list(table)[:2] == ["i", linkage.kinematics.position_column(mech)]
+        assert list(table)[:2] == ["i", linkage.kinematics.motion.position_column(mech)]
         every, _ = csv_of(capsys, command, scheme)
         assert set(table) <= set(every)
         if command == "analyze":  # frame points are constant: left out for people, kept in CSV

@@ -37,13 +37,13 @@ import numpy as np
 import pytest
 
 import linkage
-from linkage.dynamics import (DynamicsError, DynamicsSpec, course_method, dynamics_of, exact_method,
+from linkage.dynamics.pipeline import (DynamicsError, DynamicsSpec, course_method, dynamics_of, exact_method,
                               run_dynamics, simulate, steady_state)
-from linkage.forces import Loads, PointForce
-from linkage.kinetostatics import solve_reactions, virtual_power_residual
-from linkage.motors import RPM, ConstantMotor, InductionMotor, LinearMotor
-from linkage.reduced import reduced_characteristics
-from linkage.scheme import from_dict, to_dict
+from linkage.kinetostatics.loads import Loads, PointForce
+from linkage.kinetostatics.reactions import solve_reactions, virtual_power_residual
+from linkage.dynamics.motors import RPM, ConstantMotor, InductionMotor, LinearMotor
+from linkage.dynamics.reduced import reduced_characteristics
+from linkage.model.scheme import from_dict, to_dict
 
 G = 9.81
 

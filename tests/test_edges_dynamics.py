@@ -30,13 +30,13 @@ import numpy as np
 import pytest
 
 import linkage
-from linkage.dynamics import (DynamicsError, DynamicsInputError, DynamicsSpec, course_method, dynamics_of,
+from linkage.dynamics.pipeline import (DynamicsError, DynamicsInputError, DynamicsSpec, course_method, dynamics_of,
                               exact_method, run_dynamics, simulate, steady_state)
 from linkage.errors import LinkageError
-from linkage.kinetostatics import solve_reactions, virtual_power_residual
-from linkage.motors import RPM, ConstantMotor, InductionMotor, LinearMotor
-from linkage.reduced import reduced_characteristics
-from linkage.scheme import from_dict, to_dict
+from linkage.kinetostatics.reactions import solve_reactions, virtual_power_residual
+from linkage.dynamics.motors import RPM, ConstantMotor, InductionMotor, LinearMotor
+from linkage.dynamics.reduced import reduced_characteristics
+from linkage.model.scheme import from_dict, to_dict
 
 
 @pytest.fixture(autouse=True)

@@ -29,10 +29,10 @@ import pytest
 import linkage
 from _cli_io import run
 from linkage import InputError, LinkageError, SchemeError
-from linkage.dynamics import dynamics_of
-from linkage.forces import StrokeDiagram, evaluate_loads, inertia_terms, loads_of
-from linkage.kinetostatics import solve_reactions
-from linkage.scheme import SECTION_PARSERS, from_dict, to_dict
+from linkage.dynamics.pipeline import dynamics_of
+from linkage.kinetostatics.loads import StrokeDiagram, evaluate_loads, inertia_terms, loads_of
+from linkage.kinetostatics.reactions import solve_reactions
+from linkage.model.scheme import SECTION_PARSERS, from_dict, to_dict
 
 SCHEMES = linkage.shipped_schemes()
 
@@ -301,7 +301,7 @@ def test_loads_and_dynamics_are_parsed_once_at_load_time(monkeypatch):
     assert loads_of(mech) is loads and dynamics_of(mech) is spec
     motion = linkage.analyze(mech, np.radians(np.arange(0.0, 360.0, 30.0)), omega=spec.mean_speed)
     solve_reactions(motion)
-    linkage.dynamics.course_method(mech)
+    linkage.dynamics.pipeline.course_method(mech)
     assert calls == []
     # a mechanism built in Python is parsed on first use, once
     built = mech.with_extra(loads={"gravity": [0.0, 0.0]})
@@ -325,8 +325,8 @@ def test_reactions_use_the_stroke_ends_found_at_load_time(monkeypatch):
     def no_kinematics(*args, **kwargs):
         raise AssertionError("stroke ends re-derived")
 
-    monkeypatch.setattr(linkage.forces, "extreme_positions", no_kinematics)
-    monkeypatch.setattr(linkage.forces, "table_angles", no_kinematics)
+    monkeypatch.setattr(linkage.kinetostatics.loads, "extreme_positions", no_kinematics)
+    monkeypatch.setattr(linkage.kinetostatics.loads, "table_angles", no_kinematics)
     for m in (shears, press):
         after = solve_reactions(linkage.analyze(m, phi, omega=-1.0)).balancing_moment
         np.testing.assert_array_equal(after, before[m.name])
@@ -361,8 +361,8 @@ def _bad_calls():
         "moment of a revolute pair": (lambda: solve_reactions(motion2).moment("A"), InputError),
         "no pair joins": (lambda: solve_reactions(motion2).on("1", "3"), InputError),
         "inertia without speed": (lambda: inertia_terms(motion2), InputError),
-        "force of a wrong shape": (lambda: evaluate_loads(motion2, linkage.forces.Loads(
-            forces=(linkage.forces.PointForce("E", "2", np.zeros((5, 2))),))), InputError),
+        "force of a wrong shape": (lambda: evaluate_loads(motion2, linkage.kinetostatics.loads.Loads(
+            forces=(linkage.kinetostatics.loads.PointForce("E", "2", np.zeros((5, 2))),))), InputError),
         "no [dynamics]": (lambda: dynamics_of(four_bar), SchemeError),
         "no output": (lambda: linkage.extreme_positions(no_output), InputError),
         "zero positions": (lambda: linkage.table_angles(four_bar, 0), InputError),

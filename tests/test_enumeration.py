@@ -21,10 +21,10 @@ import linkage
 from assur.base import PrismaticJoint, RevoluteJoint
 from assur.generic import NewtonGroup
 from linkage.cli import main
-from linkage.enumeration import Enumeration, assignments, build_combination, enumerate_chain, measure
+from linkage.research.enumeration import Enumeration, assignments, build_combination, enumerate_chain, measure
 from linkage.errors import InputError, StructureError
-from linkage.kinetostatics import solve_reactions
-from linkage.model import Prismatic, Revolute
+from linkage.kinetostatics.reactions import solve_reactions
+from linkage.model.mechanism import Prismatic, Revolute
 
 CLOSED_FORM_KINDS = {"RRR", "RRP", "RPR", "PRP", "RPP"}
 TURN = np.linspace(0.0, 2 * np.pi, 360, endpoint=False)

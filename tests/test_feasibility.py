@@ -1,4 +1,4 @@
-"""Feasibility rules of design variants (linkage.feasibility).
+"""Feasibility rules of design variants (linkage.kinematics.feasibility).
 
 Oracles are computed here, independently of the solvers: the four-bar's Grashof condition and
 its transmission angle by the cosine law, the offset slider-crank's rod inclination and stroke in
@@ -17,7 +17,7 @@ from _texts import four_bar_toml, slider_crank_toml
 
 import linkage
 from linkage.errors import InputError, SchemeError
-from linkage.feasibility import (
+from linkage.kinematics.feasibility import (
     RULES,
     Requirements,
     Verdict,
@@ -26,7 +26,7 @@ from linkage.feasibility import (
     sweep_angles,
     transmission_angles,
 )
-from linkage.scheme import scheme_path
+from linkage.model.scheme import scheme_path
 
 
 def four_bar(crank, coupler, rocker, ground, assembly='left_of = ["A", "C"]', **kw):

@@ -3,7 +3,7 @@
 What is generated
 -----------------
 A crank (link 1, pivot O on the frame 0) followed by a chain of one to three dyads of all five
-kinds (RRR, RRP, RPR, PRP, RPP), declared through :class:`linkage.model.MechanismBuilder`
+kinds (RRR, RRP, RPR, PRP, RPP), declared through :class:`linkage.model.mechanism.MechanismBuilder`
 (``tests/_chains.py``). Every design is *drawn* in a reference configuration (crank at
 ``phi0``) in global coordinates and its lengths, guide lines, pair angles and assembly
 conditions are read off the drawing, as a designer would, so the reference configuration is a
@@ -90,8 +90,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import linkage  # noqa: E402
 from linkage.errors import LinkageError  # noqa: E402
-from linkage.kinematics import BranchWarning  # noqa: E402
-from linkage.kinetostatics import solve_reactions  # noqa: E402
+from linkage.kinematics.motion import BranchWarning  # noqa: E402
+from linkage.kinetostatics.reactions import solve_reactions  # noqa: E402
 
 import _chains as C  # noqa: E402
 

@@ -52,10 +52,10 @@ import pytest
 import linkage
 from assur.base import OK, global_point
 from linkage import LinkageError, SchemeError
-from linkage.dynamics import course_method
-from linkage.kinematics import BranchWarning
-from linkage.kinetostatics import solve_reactions
-from linkage.model import Prismatic, Revolute
+from linkage.dynamics.pipeline import course_method
+from linkage.kinematics.motion import BranchWarning
+from linkage.kinetostatics.reactions import solve_reactions
+from linkage.model.mechanism import Prismatic, Revolute
 
 SEED = 20240607
 FUZZ = max(1, int(os.environ.get("LINKAGE_FUZZ", "1") or 1))

@@ -22,7 +22,7 @@ import linkage  # noqa: E402
 from assur.base import OK, RevoluteJoint  # noqa: E402
 from assur.generic import NewtonGroup, group_class_of  # noqa: E402
 from assur.triad import Triad  # noqa: E402
-from linkage.kinetostatics import solve_reactions, virtual_power_residual  # noqa: E402
+from linkage.kinetostatics.reactions import solve_reactions, virtual_power_residual  # noqa: E402
 
 SCHEMES = Path(__file__).resolve().parent.parent / "schemes"
 

@@ -15,7 +15,7 @@ import pytest
 
 import linkage
 from assur import ANALOG_TOL
-from linkage.scheme import from_dict, to_dict
+from linkage.model.scheme import from_dict, to_dict
 
 from _edge_mechanisms import CASES, CHAIN, reference, relative_errors, rpp_reference, rpp_toml, _derivatives
 

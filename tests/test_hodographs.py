@@ -17,7 +17,7 @@ import matplotlib.pyplot as plt
 
 import linkage
 from linkage.errors import InputError, LinkageError
-from linkage.kinetostatics import solve_reactions
+from linkage.kinetostatics.reactions import solve_reactions
 from linkage.report.hodographs import main_pairs, pair_words, plot_hodographs
 from linkage.report.plots import PlotExtraMissing
 from tests._texts import four_bar_toml, slider_crank_toml

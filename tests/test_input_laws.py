@@ -19,9 +19,9 @@ import pytest
 import linkage
 from linkage import MechanismBuilder, SchemeError
 from linkage.errors import InputError
-from linkage.input_laws import InputLaw
-from linkage.kinetostatics import solve_reactions, virtual_power_residual
-from linkage.scheme import dumps, loads, scheme_path
+from linkage.model.input_laws import InputLaw
+from linkage.kinetostatics.reactions import solve_reactions, virtual_power_residual
+from linkage.model.scheme import dumps, loads, scheme_path
 
 # the shipped scheme's dimensions (schemes/five_bar_two_input.toml), m, kg, kg m^2
 O, Q = np.array([0.0, 0.0]), np.array([0.15, 0.0])
@@ -270,7 +270,7 @@ def test_cli_refuses_bad_laws_without_a_traceback(argument, message):
 def test_reduced_inertia_counts_the_second_crank_with_its_law():
     """I_red(phi) = sum(m v_S^2 + J w^2) / w_1^2 with the kinetic energy computed here (crank 4 at
     theta_4' = -1 + 0.3 cos(phi), the couplers by central differences of the circle intersection)."""
-    from linkage.reduced import reduced_characteristics
+    from linkage.dynamics.reduced import reduced_characteristics
 
     grid = np.radians(np.arange(0.0, 361.0, 2.0))
     smooth = lambda p: PHASE - p + 0.3 * np.sin(p)                  # noqa: E731

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import linkage
-from linkage.kinematics import BranchWarning
+from linkage.kinematics.motion import BranchWarning
 
 
 def test_outputs_limit_the_groups_that_run_and_give_the_same_numbers():
@@ -126,7 +126,7 @@ def test_one_point_runs_only_its_ancestors_and_no_derivatives(monkeypatch):
 
 
 def test_one_reaction_runs_the_groups_it_needs(monkeypatch):
-    from linkage.kinetostatics import solve_reactions
+    from linkage.kinetostatics.reactions import solve_reactions
 
     mech = linkage.load("six_bar")
     phi = np.radians(np.arange(0.0, 360.0, 30.0))
@@ -148,7 +148,7 @@ def test_one_reaction_runs_the_groups_it_needs(monkeypatch):
 
 
 def test_massless_links_give_no_inertia_work():
-    from linkage.forces import inertia_terms
+    from linkage.kinetostatics.loads import inertia_terms
 
     mech = linkage.load("four_bar")             # links 1, 2, 3 carry masses
     motion = linkage.analyze(mech, [0.1, 0.2], omega=5.0)

@@ -20,9 +20,9 @@ import pytest
 
 import linkage
 from linkage import SchemeError
-from linkage.forces import LinkMoment, Loads, PointForce, loads_of
-from linkage.kinetostatics import solve_reactions, virtual_power_residual
-from linkage.scheme import from_dict, to_dict
+from linkage.kinetostatics.loads import LinkMoment, Loads, PointForce, loads_of
+from linkage.kinetostatics.reactions import solve_reactions, virtual_power_residual
+from linkage.model.scheme import from_dict, to_dict
 
 G = 9.81
 OMEGA = -10.472  # rad/s, the course press (clockwise crank)

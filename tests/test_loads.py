@@ -16,9 +16,9 @@ from scipy.optimize import brentq
 
 import linkage
 from linkage import SchemeError
-from linkage.forces import LinkMoment, Loads, PointForce, StrokeDiagram, evaluate_loads, loads_of
-from linkage.kinetostatics import solve_reactions
-from linkage.scheme import from_dict, to_dict
+from linkage.kinetostatics.loads import LinkMoment, Loads, PointForce, StrokeDiagram, evaluate_loads, loads_of
+from linkage.kinetostatics.reactions import solve_reactions
+from linkage.model.scheme import from_dict, to_dict
 
 L1, L2, E = 0.0742, 0.2225, 0.01335  # the course press: crank, rod, guide offset (y = +E)
 X_MAX = math.sqrt((L1 + L2) ** 2 - E**2)  # crank and rod extended

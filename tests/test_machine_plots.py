@@ -18,9 +18,9 @@ from PIL import Image
 from scipy.integrate import cumulative_trapezoid, trapezoid
 
 import linkage
-from linkage.dynamics import dynamics_of, run_dynamics
+from linkage.dynamics.pipeline import dynamics_of, run_dynamics
 from linkage.errors import InputError
-from linkage.reduced import reduced_characteristics
+from linkage.dynamics.reduced import reduced_characteristics
 from linkage.report.machine import (
     plot_energy_inertia,
     plot_flywheel_energy,

@@ -18,11 +18,11 @@ from scipy.optimize import least_squares
 
 import assur.generic
 import linkage
-import linkage.assembly
+import linkage.kinematics.assembly
 from assur.base import NOT_CONVERGED, OK, SINGULAR
-from linkage.assembly import assembly_plans
+from linkage.kinematics.assembly import assembly_plans
 from linkage.errors import AssemblyError, ConvergenceError
-from linkage.kinematics import BranchWarning
+from linkage.kinematics.motion import BranchWarning
 
 SCHEMES = Path(__file__).resolve().parent.parent / "schemes"
 
@@ -190,9 +190,9 @@ def test_a_fast_mode_is_traced_at_a_coarse_sweep(monkeypatch, scheme):
     reference = linkage.analyze(fine, sweep, order=0)
     stacked = np.concatenate([reference.poses[k] for k in ("2", "3", "4", "5")], axis=1)
     moves = [pose_gap(stacked[(m + 1) % COARSE], stacked[m], fine.size) for m in range(COARSE)]
-    assert max(moves) > linkage.assembly.TRACE_JUMP * fine.size          # the mode is fast at this sweep
+    assert max(moves) > linkage.kinematics.assembly.TRACE_JUMP * fine.size          # the mode is fast at this sweep
 
-    monkeypatch.setattr(linkage.assembly, "BRANCH_SWEEP", COARSE)
+    monkeypatch.setattr(linkage.kinematics.assembly, "BRANCH_SWEEP", COARSE)
     coarse = linkage.loads(text)
     angles, poses = assembly_plans(coarse)[0].track
     assert len(angles) > COARSE                                            # refined between sweep angles
@@ -208,7 +208,7 @@ def test_a_fast_mode_is_traced_at_a_coarse_sweep(monkeypatch, scheme):
     np.testing.assert_allclose(got.point("P" if scheme == "class4" else "D"),
                                want.point("P" if scheme == "class4" else "D"), atol=1e-12)
 
-    monkeypatch.setattr(linkage.assembly, "REFINEMENTS", 0)
+    monkeypatch.setattr(linkage.kinematics.assembly, "REFINEMENTS", 0)
     lost = assembly_plans(linkage.loads(text))[0].track[1]
     assert any(np.any(np.isnan(v)) for v in lost.values())
 
@@ -308,7 +308,7 @@ def test_a_change_point_of_a_traced_triad_is_found_warned_and_singular():
 def test_a_newton_failure_is_reported_by_the_tables_and_the_feasibility_check(monkeypatch, capsys):
     """Status -4 is never shown as an empty row without a word, nor as "cannot be assembled"."""
     from linkage.cli import main
-    from linkage.feasibility import check
+    from linkage.kinematics.feasibility import check
     from linkage.report.results import failures
 
     mech = linkage.loads(class4_text())

@@ -18,7 +18,7 @@ import pytest
 
 import linkage
 from linkage.errors import InputError
-from linkage.plans import POLE, build_plans
+from linkage.kinetostatics.plans import POLE, build_plans
 
 from _cli_io import run
 

@@ -20,7 +20,7 @@ from matplotlib.patches import Patch  # noqa: E402
 from matplotlib.text import Annotation  # noqa: E402
 
 import linkage  # noqa: E402
-from linkage.dynamics import run_dynamics  # noqa: E402
+from linkage.dynamics.pipeline import run_dynamics  # noqa: E402
 from linkage.errors import InputError, LinkageError  # noqa: E402
 from linkage.report import plots  # noqa: E402
 from linkage.report.plots import (PlotExtraMissing, describe_column, draw_mechanism, draw_positions,  # noqa: E402

@@ -22,8 +22,8 @@ import pytest
 
 import linkage
 from linkage.errors import AssemblyError, DynamicsError, DynamicsInputError, SchemeError
-from linkage.kinetostatics import solve_reactions, virtual_power_residual
-from linkage.stroke import stroke_motion
+from linkage.kinetostatics.reactions import solve_reactions, virtual_power_residual
+from linkage.dynamics.stroke import stroke_motion
 
 from _cli_io import read_csv, read_table, run
 

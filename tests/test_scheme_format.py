@@ -30,13 +30,13 @@ from scipy.optimize import brentq
 
 import linkage
 from linkage import InputError, SchemeError
-from linkage.dynamics import (DynamicsError, DynamicsInputError, course_method, dynamics_of, exact_method,
+from linkage.dynamics.pipeline import (DynamicsError, DynamicsInputError, course_method, dynamics_of, exact_method,
                               run_dynamics, simulate, steady_state)
-from linkage.forces import diagram_value, evaluate_loads, loads_of
-from linkage.kinetostatics import solve_reactions
-from linkage.motors import LinearMotor, starting_moment
-from linkage.reduced import reduced_characteristics
-from linkage.scheme import from_dict, to_dict
+from linkage.kinetostatics.loads import diagram_value, evaluate_loads, loads_of
+from linkage.kinetostatics.reactions import solve_reactions
+from linkage.dynamics.motors import LinearMotor, starting_moment
+from linkage.dynamics.reduced import reduced_characteristics
+from linkage.model.scheme import from_dict, to_dict
 
 from _cli_io import read_csv, run
 from _texts import slider_crank_toml
@@ -480,7 +480,7 @@ def test_start_from_rest_needs_a_starting_torque(tmp_path):
         data["dynamics"].pop("initial_speed")
         data["dynamics"]["initial_rpm"] = 0
         path = tmp_path / "stalled.toml"
-        path.write_text(linkage.scheme._toml_table(data, ()))  # the TOML writer of linkage.dumps
+        path.write_text(linkage.model.scheme._toml_table(data, ()))  # the TOML writer of linkage.dumps
         with pytest.raises(SchemeError) as info:
             linkage.load(path)
         (problem,) = info.value.problems

@@ -1,4 +1,4 @@
-"""Assignment sheets and the overview of variants as A4 PDF (linkage.report.sheets).
+"""Assignment sheets and the overview of variants as A4 PDF (linkage.course.sheets).
 
 Oracles: the PDF's own structure (page objects, the page count, the media box of A4 = 210 x 297
 mm = 595.28 x 841.89 pt), poppler's pdfinfo / pdftotext where installed (as a cross-check, and
@@ -35,9 +35,9 @@ from linkage import MechanismBuilder  # noqa: E402
 from linkage.errors import InputError, LinkageError  # noqa: E402
 from linkage.report import sheets  # noqa: E402
 from linkage.report.plots import PlotExtraMissing  # noqa: E402
-from linkage.report.sheets import (ROWS_PER_PAGE, assignment_sheet, overview_figures, overview_pdf,  # noqa: E402
+from linkage.course.sheets import (ROWS_PER_PAGE, assignment_sheet, overview_figures, overview_pdf,  # noqa: E402
                                    sheet_figures, standard_scale)
-from linkage.template import load_template  # noqa: E402
+from linkage.course.template import load_template  # noqa: E402
 
 ROOT = FilePath(__file__).resolve().parents[1]
 A4_PT = (210 / 25.4 * 72, 297 / 25.4 * 72)        # 595.28 x 841.89 pt

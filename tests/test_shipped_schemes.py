@@ -19,9 +19,9 @@ import numpy as np
 import pytest
 
 import linkage
-import linkage.forces  # noqa: F401  registers the [loads] section (see test_fresh_import_loads_every_scheme)
-from linkage.kinematics import BranchWarning
-from linkage.model import Prismatic, Revolute
+import linkage.kinetostatics.loads  # noqa: F401  registers the [loads] section (see test_fresh_import_loads_every_scheme)
+from linkage.kinematics.motion import BranchWarning
+from linkage.model.mechanism import Prismatic, Revolute
 
 #: the structural formula of every shipped scheme (a spec, not an observed value)
 EXPECTED_FORMULAS = {

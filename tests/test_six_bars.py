@@ -17,7 +17,7 @@ import pytest
 
 import linkage
 from linkage.cli import main
-from linkage.kinetostatics import solve_reactions, virtual_power_residual
+from linkage.kinetostatics.reactions import solve_reactions, virtual_power_residual
 
 #: the dyads of each scheme, in the order they are placed after the crank: (inner joint, link
 #: from the first outer joint, first outer joint, link from the second outer joint, second outer

@@ -21,7 +21,7 @@ import pytest
 
 import linkage
 from linkage import MechanismBuilder, SchemeError, StructureError
-from linkage.scheme import from_dict, to_dict
+from linkage.model.scheme import from_dict, to_dict
 
 SCHEMES_DIR = Path(__file__).resolve().parent.parent / "schemes"
 SHIPPED = sorted(p.stem for p in SCHEMES_DIR.glob("*.toml"))

@@ -17,10 +17,10 @@ import numpy as np
 import pytest
 
 import linkage
-from linkage.dynamics import run_dynamics
+from linkage.dynamics.pipeline import run_dynamics
 from linkage.errors import InputError, SchemeError
-from linkage.scheme import from_dict, loads, shipped_schemes, toml_text
-from linkage.template import (
+from linkage.model.scheme import from_dict, loads, shipped_schemes, toml_text
+from linkage.course.template import (
     Parameter,
     Template,
     draws,

@@ -18,8 +18,8 @@ pytest.importorskip("tqdm", reason="variants need the report extra (tqdm)")
 
 import linkage  # noqa: E402
 from _cli_io import run  # noqa: E402
-from linkage.feasibility import check, parse_requirements  # noqa: E402
-from linkage.template import load_template, loads_template  # noqa: E402
+from linkage.kinematics.feasibility import check, parse_requirements  # noqa: E402
+from linkage.course.template import load_template, loads_template  # noqa: E402
 
 FILES = ("scheme.toml", "sheet.pdf", "key.json", "kinematics.csv", "forces.csv", "dynamics.csv")
 

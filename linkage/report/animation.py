@@ -37,24 +37,24 @@ import numpy as np
 from assur.base import CANNOT_ASSEMBLE
 
 from ..errors import InputError
-from ..extremes import table_angles
-from ..kinematics import Motion, analyze
-from ..model import Mechanism
-from ..scheme import section_of
+from ..kinematics.extremes import table_angles
+from ..kinematics.motion import Motion, analyze
+from ..model.mechanism import Mechanism
+from ..model.scheme import section_of
 from .plots import (
-    _add_artists,
-    _moving_artists,
-    _obstacles,
     _SUPPORT_DIRECTIONS,
     CAPTION_CHARS,
     FONT,
     PIN,
+    _add_artists,
     _draw_scene,
     _figure_for,
     _Geometry,
     _hull,
     _inside,
     _limits,
+    _moving_artists,
+    _obstacles,
     _place_labels,
     _pyplot,
     _samples,

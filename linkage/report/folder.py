@@ -22,11 +22,15 @@ from typing import Any
 
 import numpy as np
 
-from .. import __version__
 from ..errors import InputError, LinkageError
-from ..kinematics import structure_of
-from ..model import Mechanism
-from ..scheme import dumps, section_of
+from ..model.mechanism import Mechanism, Prismatic
+from ..model.scheme import dumps, section_of
+from ..structure import structure_of
+from ..version import __version__
+from . import machine
+from .animation import write_animation
+from .hodographs import plot_hodographs
+from .plots import draw_mechanism, draw_positions, link_role, plot_columns, plot_dynamics, plot_motion
 from .results import dynamics_results, forces_results, kinematics_results
 from .tables import format_columns, units_of
 
@@ -165,7 +169,6 @@ class _Work:
         return [self.mech.output_point] if self.mech.output_point is not None else []
 
     def mechanism_pictures(self) -> None:
-        from .plots import draw_mechanism, draw_positions
 
         motion = self.kinematics.motion
         ok = np.flatnonzero(motion.status == 0)
@@ -182,7 +185,6 @@ class _Work:
                       lambda: draw_positions(motion, sorted(set(spread)), trajectories=trajectories))
 
     def kinematic_diagrams(self) -> None:
-        from .plots import plot_motion
 
         output = self.mech.output
         if output is None:
@@ -193,8 +195,6 @@ class _Work:
                       lambda: plot_motion(self.kinematics.motion, [q, q + "'", q + "''"]))
 
     def force_pictures(self) -> None:
-        from .hodographs import plot_hodographs
-        from .plots import plot_columns
 
         columns = self.forces.columns
         # a crank is balanced by a moment (N m), a slide input by a force (N)
@@ -231,8 +231,6 @@ class _Work:
         self._write("dynamics.json", self.dynamics.json())
 
     def machine_pictures(self) -> None:
-        from . import machine
-        from .plots import plot_dynamics
 
         if self.dynamics is None:
             return
@@ -249,7 +247,6 @@ class _Work:
                       lambda: plot_dynamics(report, ["omega", "eps", "balancing_moment"]))
 
     def startup(self) -> None:
-        from . import machine
 
         if self.spec is None or self.spec.motor is None:
             self.report.notes.append("start-up from several initial speeds: left out (the scheme declares no "
@@ -259,7 +256,6 @@ class _Work:
                       lambda: machine.plot_startup(self.mech))
 
     def animation(self) -> None:
-        from .animation import write_animation
 
         try:
             write_animation(self.kinematics.motion.mechanism, self.report.folder / "animation.gif",
@@ -326,7 +322,6 @@ def _number(value: Any) -> str:
 
 def _links(mech: Mechanism) -> list[dict[str, str]]:
     """The links as the page lists them: name, role, points (local coordinates, m), mass, J."""
-    from .plots import link_role
 
     rows = []
     for name in sorted(mech.links, key=lambda n: (n != mech.frame, n)):
@@ -339,7 +334,6 @@ def _links(mech: Mechanism) -> list[dict[str, str]]:
 
 
 def _pairs(mech: Mechanism) -> list[dict[str, str]]:
-    from ..model import Prismatic
 
     return [{"name": name, "kind": "P (prismatic)" if isinstance(pair, Prismatic) else "R (revolute)",
              "links": " – ".join(pair.links)} for name, pair in sorted(mech.pairs.items())]

@@ -27,8 +27,8 @@ from itertools import pairwise
 import numpy as np
 
 from ..errors import InputError
-from ..kinematics import table_positions_deg
-from ..model import Mechanism
+from ..kinematics.motion import table_positions_deg
+from ..model.mechanism import Mechanism
 from .plots import (
     CURVE_COLOURS,
     FONT,
@@ -156,7 +156,7 @@ def plot_hodographs(reactions, pairs: Sequence[str] | None = None, *, fine=None)
     Parameters
     ----------
     reactions : Reactions
-        :func:`linkage.kinetostatics.solve_reactions` at the table positions (e.g. as ``linkage
+        :func:`linkage.kinetostatics.reactions.solve_reactions` at the table positions (e.g. as ``linkage
         forces`` makes them: the scheme's table, at its speed).
     pairs : sequence of str, optional
         The pairs to draw, in this order (default: :func:`main_pairs`).
@@ -182,7 +182,7 @@ def plot_hodographs(reactions, pairs: Sequence[str] | None = None, *, fine=None)
     >>> import matplotlib
     >>> matplotlib.use("Agg")
     >>> import io, linkage
-    >>> from linkage.kinetostatics import solve_reactions
+    >>> from linkage.kinetostatics.reactions import solve_reactions
     >>> mech = linkage.load("four_bar")
     >>> motion = linkage.analyze(mech, linkage.table_angles(mech, 12), omega=10.0)
     >>> fig = plot_hodographs(solve_reactions(motion))

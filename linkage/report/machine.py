@@ -11,7 +11,7 @@
   state);
 - :func:`plot_startup` -- the start-up with the scheme's motor from several initial speeds.
 
-The first four take a course-method :class:`~linkage.dynamics.DynamicsReport`
+The first four take a course-method :class:`~linkage.dynamics.pipeline.DynamicsReport`
 (``run_dynamics(mech, "course")``); their angle axis is ``phi_deg``, the crank angle travelled
 from the cycle's start (0 .. 360), with the table positions numbered and the output's extreme
 positions marked (:func:`~linkage.report.plots.extreme_marks`). Reduced moments refer to
@@ -21,7 +21,7 @@ matplotlib ``Figure`` about 7.5 in wide; it needs the ``plot`` extra.
 >>> import matplotlib
 >>> matplotlib.use("Agg")
 >>> import linkage
->>> from linkage.dynamics import run_dynamics
+>>> from linkage.dynamics.pipeline import run_dynamics
 >>> fig = plot_flywheel_energy(run_dynamics(linkage.load("course_slider_crank"), compare=False))
 >>> fig.axes[0].get_ylabel().split(",")[-1].strip()
 'J'
@@ -37,13 +37,13 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..dynamics import DynamicsReport, DynamicsSpec, LawOfMotion, exact_method, simulate, steady_state
+from ..dynamics.motors import starting_moment
+from ..dynamics.pipeline import DynamicsReport, DynamicsSpec, LawOfMotion, exact_method, simulate, steady_state
+from ..dynamics.reduced import reduced_characteristics
 from ..errors import InputError
-from ..kinematics import table_positions_deg
-from ..model import Mechanism
-from ..motors import starting_moment
-from ..reduced import reduced_characteristics
-from ..scheme import section_of
+from ..kinematics.motion import table_positions_deg
+from ..model.mechanism import Mechanism
+from ..model.scheme import section_of
 from .plots import (
     CURVE_COLOURS,
     FONT,
@@ -407,7 +407,7 @@ def plot_speed_two_ways(report: DynamicsReport) -> Figure:
     Markers: the course method (Mertsalov) at the table positions. Fine curve: the periodic
     steady state of the equation of motion ``I(ψ)·ψ̈ + ½·(dI/dψ)·ψ̇² = M_d + M_red(ψ)`` with the
     same constant inertia (the law's ``constant_inertia``) and a constant driving moment ``M_d``
-    that balances the cycle on the equation's grid (:func:`~linkage.dynamics.steady_state` with no
+    that balances the cycle on the equation's grid (:func:`~linkage.dynamics.pipeline.steady_state` with no
     motor; its ``M_d`` differs from the course method's where a load acts between table
     positions: both are written). The mean speed ``ω_m`` and the band ``ω_m·(1 ± δ/2)`` of the
     target δ are drawn on the speed panel; the δ of each solution is written in the legend.
@@ -501,9 +501,9 @@ def plot_startup(mech: Mechanism, initial_speeds: Sequence[float] | None = None,
     """The start-up of the machine with its motor: ``|ω|`` against the crank angle travelled.
 
     One curve per initial speed, from the equation of motion with the scheme's motor
-    (:func:`~linkage.dynamics.simulate`; a start from rest integrates its first degree in time),
+    (:func:`~linkage.dynamics.pipeline.simulate`; a start from rest integrates its first degree in time),
     and the mean speed of the periodic steady state with that motor
-    (:func:`~linkage.dynamics.steady_state`) that every start-up approaches; the declared mean
+    (:func:`~linkage.dynamics.pipeline.steady_state`) that every start-up approaches; the declared mean
     speed is drawn for comparison.
 
     Parameters

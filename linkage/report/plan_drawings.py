@@ -14,7 +14,7 @@ length on the drawing and its value.
 >>> import matplotlib
 >>> matplotlib.use("Agg")
 >>> import numpy as np, linkage
->>> from linkage.plans import build_plans
+>>> from linkage.kinetostatics.plans import build_plans
 >>> from linkage.report.plan_drawings import draw_plan, nice_scale
 >>> plans = build_plans(linkage.analyze(linkage.load("slider_crank"), np.radians([45.0]), omega=-10.0))
 >>> fig = draw_plan(plans, 0, "velocity", scale=0.01)
@@ -37,8 +37,8 @@ from typing import Iterable, Mapping, Sequence
 import numpy as np
 
 from ..errors import InputError
-from ..plans import POLE, ForcePolygon, Plans
-from .plots import FONT, LINK_COLOURS, SMALL, _caption, _clip_lengths, _hull, _pyplot, _sub
+from ..kinetostatics.plans import POLE, ForcePolygon, Plans
+from .plots import FONT, LINK_COLOURS, SMALL, _caption, _clip_lengths, _hull, _pyplot, _sub, draw_mechanism
 
 __all__ = ["TARGET_MM", "nice_scale", "drawing_scales", "draw_plan", "draw_force_polygons", "draw_lever", "draw_sheet",
            "write_plan_drawings"]
@@ -616,7 +616,7 @@ def draw_plan(plans: Plans, position: int, quantity: str = "velocity", *, scale:
     Parameters
     ----------
     plans : Plans
-        From :func:`linkage.plans.build_plans`.
+        From :func:`linkage.kinetostatics.plans.build_plans`.
     position : int
         Index of the position in ``plans.motion.phi`` (0 is the first).
     quantity : {"velocity", "acceleration"}
@@ -688,7 +688,6 @@ def draw_sheet(plans: Plans, position: int):
     """One sheet (A3 landscape, true to size when printed at 100 %) for one position: the
     mechanism to scale, the plans of velocities and accelerations, the force polygons and
     Zhukovsky's lever, each at a scale chosen to fill its cell and written on it."""
-    from .plots import draw_mechanism
 
     plt = _pyplot()
     i = _check(plans, position)

@@ -50,8 +50,9 @@ import numpy as np
 from assur.base import global_point
 
 from ..errors import InputError, LinkageError
-from ..kinematics import input_sweep
-from ..model import Mechanism, Prismatic
+from ..kinematics.extremes import extreme_positions
+from ..kinematics.motion import analyze, input_sweep, table_positions_deg
+from ..model.mechanism import Mechanism, Prismatic
 from .tables import column_unit
 
 __all__ = ["PlotExtraMissing", "ColumnWords", "describe_column", "link_role", "unit_for_people", "extreme_marks",
@@ -366,7 +367,6 @@ def extreme_marks(mechanism: Mechanism, phi, quantity: str | None = None) -> lis
     >>> [(round(d, 2), t) for d, t in extreme_marks(mech, linkage.table_angles(mech, 12))]
     [(0.0, '$x_{\\\\mathrm{B}}$ max'), (182.59, '$x_{\\\\mathrm{B}}$ min'), (360.0, '$x_{\\\\mathrm{B}}$ max')]
     """
-    from ..extremes import extreme_positions
 
     phi = np.atleast_1d(np.asarray(phi, dtype=float))
     ext = extreme_positions(mechanism, quantity)
@@ -719,7 +719,6 @@ def plot_motion(motion, names: Sequence[str], *, extremes: bool | str = True, po
     >>> fig.savefig(io.BytesIO(), format="svg")
     >>> matplotlib.pyplot.close(fig)
     """
-    from ..kinematics import analyze
 
     _pyplot()
     mech = motion.mechanism
@@ -738,7 +737,7 @@ def plot_motion(motion, names: Sequence[str], *, extremes: bool | str = True, po
 
 
 def plot_dynamics(report, names: Sequence[str] = ("balancing_moment",), *, extremes: bool = True):
-    """Per-position results of the machine's dynamics (:func:`linkage.dynamics.run_dynamics`).
+    """Per-position results of the machine's dynamics (:func:`linkage.dynamics.pipeline.run_dynamics`).
 
     One panel per column, the table positions marked and numbered, the extreme positions of the
     output marked. Moment panels carry the mean driving moment ``M_d``: on the balancing moment
@@ -764,7 +763,7 @@ def plot_dynamics(report, names: Sequence[str] = ("balancing_moment",), *, extre
     >>> import matplotlib
     >>> matplotlib.use("Agg")
     >>> import io, linkage
-    >>> from linkage.dynamics import run_dynamics
+    >>> from linkage.dynamics.pipeline import run_dynamics
     >>> report = run_dynamics(linkage.load("course_slider_crank"), compare=False)
     >>> fig = plot_dynamics(report, ["balancing_moment", "omega"])
     >>> fig.legends[0].get_texts()[1].get_text()
@@ -1132,7 +1131,6 @@ def _block_size(u: float, on_frame: bool) -> tuple[float, float]:
 def _caption(motion, i: int, trajectories: Sequence[str] = (), compact: bool = False) -> str:
     """The position number and the input angle in words (and what the dashed lines are), in lines
     that fit above a drawing: :data:`CAPTION_CHARS` (:data:`COMPACT_CHARS` for a panel of a grid)."""
-    from ..kinematics import table_positions_deg
 
     mech = motion.mechanism
     if not mech.coordinate.is_angle:

@@ -18,12 +18,16 @@ from typing import Any
 
 import numpy as np
 
-from ..dynamics import DynamicsReport, run_dynamics
+from assur.base import CANNOT_ASSEMBLE, NOT_CONVERGED, SINGULAR
+
+from ..dynamics.pipeline import DynamicsReport, run_dynamics
 from ..errors import InputError
-from ..extremes import table_angles
-from ..kinematics import Motion, analyze, position_column, structure_of, table_positions_deg
-from ..model import Mechanism
-from ..scheme import section_of
+from ..kinematics.extremes import table_angles
+from ..kinematics.motion import Motion, analyze, position_column, table_positions_deg
+from ..kinetostatics.reactions import solve_reactions, virtual_power_residual
+from ..model.mechanism import Mechanism
+from ..model.scheme import section_of
+from ..structure import structure_of
 from .tables import format_columns, units_of
 
 __all__ = ["JSON_CONVENTIONS", "DynamicsResults", "InputRange", "TableResults", "declared_rotation",
@@ -52,7 +56,7 @@ class DynamicsResults:
 
 def dynamics_results(mech: Mechanism, method: str = "course", *, positions: int | None = None,
                      delta: float | None = None, mean_speed: float | None = None) -> DynamicsResults:
-    """Run :func:`linkage.dynamics.run_dynamics` and arrange its results as ``linkage dynamics``
+    """Run :func:`linkage.dynamics.pipeline.run_dynamics` and arrange its results as ``linkage dynamics``
     prints them (arguments and errors as there)."""
     report = run_dynamics(mech, method, positions=positions, delta=delta, mean_speed=mean_speed)
     law = report.law
@@ -92,7 +96,7 @@ class TableResults:
     """A table of ``linkage analyze`` or ``linkage forces``: ``columns``, the JSON metadata
     ``meta`` (scheme, positions, start, phi0_deg, direction, failed ...), the ``motion`` analysed,
     the ``notes`` and ``warnings`` to say to the user (one line each) and, for ``linkage forces``,
-    the :class:`~linkage.kinetostatics.Reactions` the columns come from."""
+    the :class:`~linkage.kinetostatics.reactions.Reactions` the columns come from."""
 
     columns: dict[str, np.ndarray]
     meta: dict[str, Any]
@@ -184,7 +188,6 @@ def failures(motion: Motion) -> tuple[list[dict], list[str]]:
     did not converge (a group solved by it, docs/groups.md): one JSON entry per
     position (``position``, ``phi_deg``, ``input_angle_deg``, ``problem``; for a singular one the
     least conditioned ``group`` and its ``conditioning``) and one warning line per problem."""
-    from assur.base import CANNOT_ASSEMBLE, NOT_CONVERGED, SINGULAR
 
     failed, lines = [], []
     mech = motion.mechanism
@@ -256,7 +259,6 @@ def forces_results(mech: Mechanism, positions: int | None = None, start: str | f
     """The table of ``linkage forces``: reactions and the balancing moment at the scheme's table
     positions, at the input speed ``omega`` (rad/s, signed; default the scheme's mean speed, else
     a static analysis) and acceleration ``eps`` (rad/s^2)."""
-    from ..kinetostatics import solve_reactions, virtual_power_residual
 
     notes: list[str] = []
     spec = section_of(mech, "dynamics")

@@ -4,7 +4,7 @@ variant with its scheme, printable sheet and answer key, and an index (``linkage
 The data flow is three stages, each a function of the previous one's result:
 
 1. :func:`select_variants` -- draws distinct variants reproducibly from a seed (or takes a
-   teacher's table), checks each with :func:`linkage.feasibility.check` and keeps the first
+   teacher's table), checks each with :func:`linkage.kinematics.feasibility.check` and keeps the first
    ``count`` feasible ones, counting how many draws each rule rejected;
 2. :func:`build_variant` -- one variant's files as bytes (scheme, key, tables, sheet); a pure
    function of its arguments, so it runs the same in this process, in worker processes
@@ -15,7 +15,7 @@ The data flow is three stages, each a function of the previous one's result:
 The same template, seed and count give byte-identical keys, tables, sheets and index, whatever
 the output folder, the number of workers or the scheduler.
 
->>> from linkage.template import load_template
+>>> from linkage.course.template import load_template
 >>> chosen = select_variants(load_template("press_slider_crank"), count=2, seed=1)
 >>> [v.label for v in chosen.variants], chosen.draws >= 2
 (['1', '2'], True)
@@ -32,11 +32,12 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from .errors import InputError, LinkageError
-from .feasibility import RULES, Requirements, check, parse_requirements
-from .report.results import dynamics_results, forces_results, kinematics_results
-from .report.tables import format_columns
-from .scheme import loads, toml_text
+from ..errors import InputError, LinkageError
+from ..kinematics.feasibility import RULES, Requirements, Verdict, check, parse_requirements
+from ..model.scheme import loads, toml_text
+from ..report.results import dynamics_results, forces_results, kinematics_results
+from ..report.tables import format_columns
+from .sheets import assignment_sheet, overview_pdf
 from .template import Template, draws, given_variants
 
 __all__ = ["Variant", "Selection", "select_variants", "build_variant", "write_variants", "VariantFailed",
@@ -132,9 +133,9 @@ def select_variants(template: Template, count: int, seed: int | None = None, *,
     count : int
         Variants wanted (>= 1).
     seed : int, optional
-        Seed of the draws (:func:`linkage.template.draws`); needed without ``given``.
+        Seed of the draws (:func:`linkage.course.template.draws`); needed without ``given``.
     given : path, optional
-        A CSV of given variants (:func:`linkage.template.given_variants`), taken in its order;
+        A CSV of given variants (:func:`linkage.course.template.given_variants`), taken in its order;
         its ``variant`` column labels them.
     max_draws : int, optional
         Stop after this many draws (default ``max(1000, 50 * count)``).
@@ -183,7 +184,6 @@ def select_variants(template: Template, count: int, seed: int | None = None, *,
 def _verdict(template: Template, free: Mapping[str, Any], requirements: Requirements):
     """The feasibility verdict of one draw; a draw whose derived values or scheme are invalid is
     rejected under "invalid" with its message."""
-    from .feasibility import Verdict
 
     try:
         text = variant_text(template, "check", free)
@@ -208,7 +208,6 @@ def build_variant(template: Template, variant: Variant) -> dict[str, bytes]:
     VariantFailed
         The variant cannot be solved or drawn (naming the variant and the cause).
     """
-    from .report.sheets import assignment_sheet
 
     try:
         text = variant_text(template, variant.label, variant.free)
@@ -301,7 +300,6 @@ def write_variants(selection: Selection, out: str | Path, *, workers: int = 1, s
     list of Path
         The variant folders, in order.
     """
-    from .report.sheets import overview_pdf
 
     out = Path(out)
     if out.exists() and not out.is_dir():

@@ -1,7 +1,7 @@
 """Loads on a mechanism: gravity, inertia, external forces and moments, force diagrams.
 
 docs/methods.md, "Loads". A :class:`Loads` collects what acts on the links; given a
-:class:`~linkage.kinematics.Motion` with real speeds it is evaluated into per-position
+:class:`~linkage.kinematics.motion.Motion` with real speeds it is evaluated into per-position
 :class:`LoadTerm` s (a force at a point of a link and a moment on the link), which the
 kinetostatics and the dynamics consume.
 
@@ -49,11 +49,13 @@ from typing import Any, Iterable, Mapping, Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .errors import InputError, LinkageError, SchemeError
-from .extremes import extreme_positions, table_angles, wrap_angle
-from .kinematics import Motion
-from .model import Mechanism, _angle, check_number, unknown_keys
-from .scheme import register_section, section_of
+from assur.base import cross, point_analogs
+
+from ..errors import InputError, LinkageError, SchemeError
+from ..kinematics.extremes import extreme_positions, table_angles, wrap_angle
+from ..kinematics.motion import Motion, input_sweep, parse_quantity
+from ..model.mechanism import Mechanism, _angle, check_number, unknown_keys
+from ..model.scheme import register_section, section_of
 
 __all__ = [
     "StrokeDiagram",
@@ -370,7 +372,6 @@ def _diagram(mech: Mechanism, raw: Any, quantity: str | None, where: str, proble
                             f"\"L.theta\" or \"K.s\": the coordinate whose working stroke its fractions "
                             f"measure, got {quantity!r}")
             return None
-        from .kinematics import parse_quantity
 
         try:
             parse_quantity(mech, quantity)
@@ -528,7 +529,6 @@ def _direction(mech: Mechanism, spec: Mapping[str, Any], where: str, problems: l
 def _coincide(mech: Mechanism, direction: Direction) -> str | None:
     """Why the line through the two points of ``direction`` is undefined (they coincide at some
     input angle of the turn or range), or None."""
-    from .kinematics import input_sweep
 
     motion = input_sweep(mech)
     phi = motion.phi
@@ -767,7 +767,6 @@ def inertia_terms(motion: Motion, links: Iterable[str] | None = None) -> list[Lo
     """
     if motion.omega is None or motion.second is None:
         raise InputError("inertia loads need real accelerations: analyze(..., order=2, omega=..., eps=...)")
-    from assur.base import point_analogs
 
     mech = motion.mechanism
     w, e = motion.omega, motion.eps
@@ -789,7 +788,6 @@ def inertia_terms(motion: Motion, links: Iterable[str] | None = None) -> list[Lo
 def generalized_loads(motion: Motion, terms: Sequence[LoadTerm]) -> dict[str, np.ndarray]:
     """Sum of terms per link as ``(Fx, Fy, moment about the link's local origin)`` ``(N, 3)``
     (zeros for the drivers of cylinder inputs too, which the groups load)."""
-    from assur.base import cross
 
     n = len(motion.phi)
     out = {k: np.zeros((n, 3)) for k in [*motion.mechanism.links, *motion.structure.inputs]}

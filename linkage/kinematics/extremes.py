@@ -18,9 +18,11 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import brentq
 
-from .errors import InputError
-from .kinematics import _cache, analyze
-from .model import Mechanism
+from assur.base import NOT_CONVERGED
+
+from ..errors import InputError
+from ..model.mechanism import Mechanism
+from .motion import analyze
 
 __all__ = ["Extremes", "extreme_positions", "table_angles", "wrap_angle"]
 
@@ -93,7 +95,7 @@ def extreme_positions(mech: Mechanism, quantity: str | None = None, *, samples: 
     """
     quantity = _output_quantity(mech, quantity)
     key = ("extremes", quantity, samples, xtol)
-    cache = _cache(mech)
+    cache = mech.cache
     if key not in cache:
         cache[key] = _find_extremes(mech, quantity, samples, xtol)
     return cache[key]
@@ -138,7 +140,6 @@ def _find_extremes(mech: Mechanism, quantity: str, samples: int, xtol: float) ->
 def _raise_unconverged(mech: Mechanism, grid: np.ndarray, quantity: str, status: np.ndarray) -> None:
     """Where Newton's method did not converge, raise its :class:`~linkage.errors.ConvergenceError`
     (naming the group, the angles and the residuals) rather than "cannot be assembled"."""
-    from assur.base import NOT_CONVERGED
 
     if np.any(status == NOT_CONVERGED):
         analyze(mech, grid[status == NOT_CONVERGED], order=1, outputs=[quantity])

@@ -17,14 +17,14 @@ The rules, in the order they are checked (the first that fails is the verdict's 
   range);
 - ``"non_singular"``: no group is singular (status -2) at any angle;
 - ``"no_change_point"``: no group passes a change point (docs/numerics.md), and the analysis
-  raises no :class:`~linkage.kinematics.BranchWarning`;
+  raises no :class:`~linkage.kinematics.motion.BranchWarning`;
 - ``"transmission_angle"``: the smallest transmission angle over the travel is at least the
   required one;
 - ``"stroke"``: the stroke of the scheme's output lies within the required bounds.
 
 A change point is a singular position by nature, and the deltoid's can even fail to assemble at
 the one angle where its pivots coincide: angles within one step of the sweep (or
-:data:`~linkage.assembly.CROSSING_STEP`, whichever is larger) of a change point are therefore
+:data:`~linkage.kinematics.assembly.CROSSING_STEP`, whichever is larger) of a change point are therefore
 judged by ``"no_change_point"`` alone, not by ``"full_rotation"`` or ``"non_singular"``.
 """
 
@@ -53,10 +53,11 @@ from assur.base import (
     rotate,
 )
 
+from ..errors import InputError, LinkageError, SchemeError
+from ..model.mechanism import Mechanism
+from ..structure import structure_of
 from .assembly import CROSSING_STEP, assembly_plans
-from .errors import InputError, LinkageError, SchemeError
-from .kinematics import BranchWarning, Motion, analyze, structure_of
-from .model import Mechanism
+from .motion import BranchWarning, Motion, analyze
 
 __all__ = [
     "RULES",

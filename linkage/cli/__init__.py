@@ -45,16 +45,32 @@ from typing import Callable, Sequence
 
 import numpy as np
 
-from . import __version__
-from .errors import InputError, LinkageError, SchemeError
-from .kinematics import structure_of
-from .motors import RPM
-from .model import MAX_ANGLE_DEG, MAX_MAGNITUDE, MAX_POSITIONS
-from .report import FORMATS, format_columns
-from .report.results import (JSON_CONVENTIONS, NUMERICAL_WARNING, InputRange, declared_rotation, forces_results,
-                             kinematics_results)
-from .report.tables import select_columns, table_width, units_of
-from .scheme import load, section_of, shipped_schemes
+from ..course.template import load_template
+from ..course.variants import select_variants, write_variants
+from ..dynamics.motors import RPM
+from ..dynamics.pipeline import _override, simulate
+from ..dynamics.stroke import stroke_motion
+from ..errors import InputError, LinkageError, SchemeError
+from ..kinetostatics.plans import build_plans, require_crank_input
+from ..model.input_laws import InputLaw, table_problems
+from ..model.mechanism import MAX_ANGLE_DEG, MAX_MAGNITUDE, MAX_POSITIONS
+from ..model.scheme import load, section_of, shipped_schemes
+from ..report import FORMATS, format_columns
+from ..report.folder import require_report_extra, write_report
+from ..report.plan_drawings import drawing_scales, write_plan_drawings
+from ..report.results import (
+    JSON_CONVENTIONS,
+    NUMERICAL_WARNING,
+    InputRange,
+    declared_rotation,
+    dynamics_results,
+    forces_results,
+    kinematics_results,
+)
+from ..report.tables import select_columns, table_width, units_of
+from ..research.enumeration import COLUMN_UNITS, CRANK_FACTORS, DEFAULT_OMEGA, MIN_CONDITIONING, enumerate_chain
+from ..structure import structure_of
+from ..version import __version__
 
 __all__ = ["main", "COMMANDS"]
 
@@ -249,7 +265,6 @@ def _add_scheme_argument(p: argparse.ArgumentParser) -> None:
 
 def _input_law(text: str):
     """``LINK:RATIO[:PHASE_DEG]`` or ``LINK:FILE.csv`` -> ``(link, InputLaw)``."""
-    from .input_laws import InputLaw, table_problems
 
     link, sep, law = text.partition(":")
     if not (link and sep and law):
@@ -628,7 +643,6 @@ def _add_dynamics(sub) -> None:
 
 def _cmd_stroke(args: argparse.Namespace, mech) -> int:
     """``linkage dynamics`` for a slide input: the law of motion over the stroke."""
-    from .stroke import stroke_motion
 
     crank_only = [option for option, value in (("--delta", args.delta), ("--omega", args.omega),
                                                ("--rpm", args.rpm)) if value is not None]
@@ -672,8 +686,6 @@ def _dynamics_view(columns: dict) -> list[str]:
 
 
 def _cmd_dynamics(args: argparse.Namespace) -> int:
-    from .dynamics import _override, simulate
-    from .report.results import dynamics_results
 
     mech = _load_scheme(args)
     if not mech.coordinate.is_angle:
@@ -805,7 +817,6 @@ def _add_report(sub) -> None:
 
 
 def _cmd_report(args: argparse.Namespace) -> int:
-    from .report.folder import require_report_extra, write_report
 
     require_report_extra()
     mech = _load_scheme(args)
@@ -862,9 +873,6 @@ def _add_variants(sub) -> None:
 
 
 def _cmd_variants(args: argparse.Namespace) -> int:
-    from .report.folder import require_report_extra
-    from .template import load_template
-    from .variants import select_variants, write_variants
 
     require_report_extra("linkage variants")
     if args.table is None and args.seed is None:
@@ -891,7 +899,6 @@ def _cmd_variants(args: argparse.Namespace) -> int:
 
 
 def _add_enumerate(sub) -> None:
-    from .enumeration import CRANK_FACTORS, DEFAULT_OMEGA, MIN_CONDITIONING
 
     p = sub.add_parser(
         "enumerate", help="every R/P assignment of a scheme's pairs, each as a scheme that runs a full turn",
@@ -927,7 +934,6 @@ def _add_enumerate(sub) -> None:
 
 
 def _cmd_enumerate(args: argparse.Namespace) -> int:
-    from .enumeration import COLUMN_UNITS, enumerate_chain
 
     def progress(iterable, total=None):
         try:
@@ -1019,8 +1025,6 @@ def _add_plans(sub) -> None:
 def _cmd_plans(args: argparse.Namespace) -> int:
     import json
 
-    from .plans import build_plans, require_crank_input
-    from .report.plan_drawings import drawing_scales, write_plan_drawings
 
     mech = _load_scheme(args)
     require_crank_input(mech)

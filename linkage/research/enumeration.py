@@ -48,17 +48,18 @@ import numpy as np
 from assur.base import OK, SINGULAR, PrismaticJoint, global_point
 from assur.generic import TRACE_JUMP, newton
 
-from .assembly import has_modes, poses_distance
-from .errors import AssemblyError, InputError, LinkageError, SchemeError, StructureError
-from .extremes import extreme_positions, wrap_angle
-from .feasibility import check, sweep_angles
-from .forces import loads_of
-from .kinematics import BranchWarning, analyze, input_poses, input_sweep
-from .kinetostatics import solve_reactions
-from .model import Mechanism, MechanismBuilder, Prismatic, Revolute
-from .report import format_columns
-from .scheme import dumps, load, loads
-from .structure import Structure, decompose
+from ..errors import AssemblyError, InputError, LinkageError, SchemeError, StructureError
+from ..kinematics.assembly import has_modes, poses_distance
+from ..kinematics.extremes import extreme_positions, wrap_angle
+from ..kinematics.feasibility import check, sweep_angles
+from ..kinematics.inputs import input_poses
+from ..kinematics.motion import BranchWarning, analyze, input_sweep
+from ..kinetostatics.loads import loads_of
+from ..kinetostatics.reactions import solve_reactions
+from ..model.mechanism import Mechanism, MechanismBuilder, Prismatic, Revolute
+from ..model.scheme import dumps, load, loads
+from ..report import format_columns
+from ..structure import Structure, decompose
 
 __all__ = [
     "CRANK_FACTORS",
@@ -761,7 +762,7 @@ def mode_conditions(mech: Mechanism, place: Placement, index: int,
     (``place.turn``), then by its margin at the reference angle: the smaller of how far the mode's
     point lies on its side of the line and how far every other mode's lies on the other, m. Which
     mode a condition picks over a turn is decided when the scheme is loaded
-    (:mod:`linkage.assembly`); :func:`enumerate_chain` checks that it is this one.
+    (:mod:`linkage.kinematics.assembly`); :func:`enumerate_chain` checks that it is this one.
     """
     group = place.structure.groups[index]
     placed = {mech.frame, *place.structure.inputs} | {k for g in place.structure.groups[:index + 1] for k in g.links}
@@ -969,7 +970,7 @@ def _one_line(text: object) -> str:
 
 
 def _full_turn_problem(mech: Mechanism) -> tuple[str | None, dict]:
-    """Why ``mech`` does not run a full turn (:func:`linkage.feasibility.check`: it assembles at
+    """Why ``mech`` does not run a full turn (:func:`linkage.kinematics.feasibility.check`: it assembles at
     every angle of a 1 deg sweep, stays regular, passes no change point) or comes close to a
     singular position (:func:`_too_close_to_singular` on every group's conditioning), or None;
     and the check's figures."""

@@ -11,7 +11,7 @@ on the guide, normal to the guide, and the moment of the slider on the guide abo
 point).
 
 >>> import numpy as np, linkage
->>> from linkage.kinetostatics import solve_reactions, virtual_power_residual
+>>> from linkage.kinetostatics.reactions import solve_reactions, virtual_power_residual
 >>> mech = linkage.load("four_bar")
 >>> motion = linkage.analyze(mech, np.radians([0.0, 45.0]), omega=10.0, eps=0.0)
 >>> reactions = solve_reactions(motion)
@@ -22,7 +22,6 @@ True
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-
 from typing import Iterable
 
 import numpy as np
@@ -31,9 +30,10 @@ from numpy.typing import ArrayLike
 from assur.base import OK, DrivenPrismaticJoint, PrismaticJoint, point_analogs
 from assur.rows import rows_of
 
-from .errors import InputError
-from .forces import LoadTerm, Loads, evaluate_loads, generalized_loads, inertia_terms, loads_of
-from .kinematics import Motion, angle_in_half_turn, input_angles
+from ..errors import InputError
+from ..kinematics.inputs import input_angles
+from ..kinematics.motion import Motion, angle_in_half_turn
+from .loads import Loads, LoadTerm, evaluate_loads, generalized_loads, inertia_terms, loads_of
 
 __all__ = ["Reactions", "reactions_under", "solve_reactions", "virtual_power_residual"]
 
@@ -56,7 +56,7 @@ class Reactions:
     notes : tuple of str
     balancing_moments : dict of input link -> ndarray (N,)
         The balancing moment of every input link, N m (CCW positive), or force, N, for a slide
-        input: with several inputs (:class:`~linkage.input_laws.InputLaw`), each motor's share; the
+        input: with several inputs (:class:`~linkage.model.input_laws.InputLaw`), each motor's share; the
         first is ``balancing_moment``. Keyed by ``Structure.inputs`` (a cylinder's by its driver,
         ``"K.s"`` for the pair K).
     """
@@ -145,7 +145,7 @@ def solve_reactions(
         Kinematics with second analogs; with ``omega`` (and ``eps``) when ``inertia`` is on.
     loads : Loads, optional
         Default: the loads the mechanism declares (gravity alone when it declares none), parsed
-        once with the scheme (:func:`linkage.forces.loads_of`); force diagrams carry their stroke
+        once with the scheme (:func:`linkage.kinetostatics.loads.loads_of`); force diagrams carry their stroke
         ends, so no kinematics is re-run here.
     inertia : bool
         Include inertia forces and moments (needs ``motion.omega``).
@@ -195,7 +195,7 @@ def reactions_under(motion: Motion, terms: list[LoadTerm], pairs: Iterable[str] 
                     notes: tuple[str, ...] = ()) -> Reactions:
     """Reactions and the balancing moment under load terms already evaluated at the motion's
     positions (:func:`solve_reactions` evaluates the mechanism's declared loads first; a
-    batch of variants gives its own, :func:`linkage.batch_reactions.variant_reactions`).
+    batch of variants gives its own, :func:`linkage.kinetostatics.batch.variant_reactions`).
 
     ``terms`` must hold the loads on every link the reactions in ``pairs`` need (default: every
     pair and the balancing moment).

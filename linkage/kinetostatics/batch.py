@@ -3,10 +3,10 @@
 :func:`variant_reactions` takes the kinematics of V variants (:func:`linkage.analyze_variants`)
 and each variant's masses, moments of inertia, centres of mass, external forces and moments as
 arrays, and solves the reactions in every pair and the balancing moment of all V n positions in
-one call, through the same group solvers as :func:`linkage.kinetostatics.solve_reactions`.
+one call, through the same group solvers as :func:`linkage.kinetostatics.reactions.solve_reactions`.
 
 >>> import numpy as np, linkage
->>> from linkage.batch_reactions import variant_reactions
+>>> from linkage.kinetostatics.batch import variant_reactions
 >>> mech = linkage.load("four_bar")
 >>> batch = linkage.analyze_variants(mech, np.radians([0.0, 90.0]), {"1": {"A": [[0.1, 0.0], [0.12, 0.0]]}})
 >>> reactions = variant_reactions(batch, omega=10.0, mass={"2": [3.0, 4.0]})
@@ -24,10 +24,10 @@ from numpy.typing import ArrayLike
 
 from assur.base import point_analogs
 
-from .batch import VariantMotion, _per_position, link_points
-from .errors import InputError
-from .forces import LoadTerm, loads_of
-from .kinetostatics import Reactions, reactions_under, virtual_power_residual
+from ..errors import InputError
+from ..kinematics.batch import VariantMotion, _per_position, link_points
+from .loads import LoadTerm, loads_of
+from .reactions import Reactions, reactions_under, virtual_power_residual
 
 __all__ = ["VariantReactions", "variant_reactions"]
 
@@ -67,7 +67,7 @@ class VariantReactions:
 
     def virtual_power_residual(self) -> np.ndarray:
         """The virtual-power check of every position ``(V, n)`` (see
-        :func:`linkage.kinetostatics.virtual_power_residual`; <= 1e-9 where the status is OK)."""
+        :func:`linkage.kinetostatics.reactions.virtual_power_residual`; <= 1e-9 where the status is OK)."""
         return virtual_power_residual(self.flat).reshape(self.variants.status.shape)
 
 

@@ -50,9 +50,11 @@ from typing import Any, Callable
 import numpy as np
 
 from ..errors import InputError
-from ..kinematics import analyze
-from ..model import Mechanism, Prismatic
-from .plots import INSTALL_HINT, PlotExtraMissing, _Geometry, _rail_hatch, _support, draw_mechanism
+from ..kinematics.motion import analyze
+from ..model.mechanism import Mechanism, Prismatic
+from ..model.scheme import section_of
+from ..report.plots import INSTALL_HINT, PlotExtraMissing, _Geometry, _rail_hatch, _support, draw_mechanism
+from ..report.results import declared_rotation, table_defaults, table_positions
 
 __all__ = ["assignment_sheet", "overview_pdf", "sheet_figures", "overview_figures", "standard_scale",
            "scale_text", "table_motion", "ROWS_PER_PAGE", "A4"]
@@ -169,7 +171,6 @@ def table_motion(mech: Mechanism):
     [dynamics] positions, start and rotation: :func:`linkage.report.results.table_positions`): a
     :class:`~linkage.Motion` of order 0; positions that do not assemble are masked (drawing one
     of them is an error)."""
-    from .results import declared_rotation, table_defaults, table_positions
 
     direction = declared_rotation(mech)
     phi, _ = table_positions(mech, *table_defaults(mech), direction)
@@ -178,7 +179,6 @@ def table_motion(mech: Mechanism):
 
 def _rotation(mech: Mechanism) -> int | None:
     """+1 / -1: the sign of the scheme's declared mean speed; None when it declares none."""
-    from ..scheme import section_of
 
     spec = section_of(mech, "dynamics")
     return spec.rotation if spec is not None else None

@@ -8,7 +8,7 @@ Three ways to the crank's law of motion, all on any mechanism the graph can expr
 - :func:`exact_method` -- the energy equation without Mertsalov's approximation on a fine grid,
   and the exact flywheel for the same coefficient of speed fluctuation;
 - :func:`steady_state` / :func:`simulate` -- the equation of motion with a motor characteristic
-  (:mod:`linkage.motors`), integrated with ``scipy.integrate.solve_ivp``: a start-up transient
+  (:mod:`linkage.dynamics.motors`), integrated with ``scipy.integrate.solve_ivp``: a start-up transient
   over K cycles, and the periodic steady state by shooting.
 
 :func:`run_dynamics` runs the whole course pipeline in one call: reduced characteristics, law of
@@ -32,15 +32,22 @@ from scipy.integrate import solve_ivp
 from scipy.interpolate import CubicSpline
 from scipy.optimize import brentq
 
-from .errors import DynamicsError, DynamicsInputError, LinkageError, SchemeError
-from .extremes import extreme_positions, table_angles
-from .kinematics import analyze, table_positions_deg
-from .kinetostatics import solve_reactions
-from .model import (MAX_MAGNITUDE, MAX_POSITIONS, MIN_MAGNITUDE, Mechanism, _is_number, check_number,
-                    unknown_keys)
+from ..errors import DynamicsError, DynamicsInputError, LinkageError, SchemeError
+from ..kinematics.extremes import extreme_positions, table_angles
+from ..kinematics.motion import analyze, table_positions_deg
+from ..kinetostatics.reactions import solve_reactions
+from ..model.mechanism import (
+    MAX_MAGNITUDE,
+    MAX_POSITIONS,
+    MIN_MAGNITUDE,
+    Mechanism,
+    _is_number,
+    check_number,
+    unknown_keys,
+)
+from ..model.scheme import register_section, section_of
 from .motors import RPM, ConstantMotor, motor_from_spec, starting_moment
 from .reduced import Reduced, reduced_characteristics
-from .scheme import register_section, section_of
 
 __all__ = [
     "DynamicsError",
@@ -117,7 +124,7 @@ def _check_spec(spec: DynamicsSpec) -> DynamicsSpec:
     _require(spec.initial_speed is None or (_real(spec.initial_speed) and spec.initial_speed >= 0), "initial_speed",
              spec.initial_speed, "a finite number >= 0 (|omega| at the start, rad/s; 0: from rest)")
     _require(spec.motor is None or callable(spec.motor), "motor", spec.motor,
-             "a motor characteristic motor(w) -> M (linkage.motors)")
+             "a motor characteristic motor(w) -> M (linkage.dynamics.motors)")
     return spec
 
 
@@ -157,7 +164,7 @@ class DynamicsSpec:
     flywheel : float
         An installed flywheel on the input shaft, kg m^2.
     motor : callable or None
-        Motor characteristic reduced to the input (:mod:`linkage.motors`).
+        Motor characteristic reduced to the input (:mod:`linkage.dynamics.motors`).
     initial_speed : float or None
         Initial |omega| of the start-up transient, rad/s; 0 starts from rest (the motor needs a
         starting torque, see :func:`simulate`).
@@ -187,7 +194,7 @@ class DynamicsSpec:
 
 
 #: Largest number of cycles of a start-up transient a scheme may declare (the integration time
-#: grows with it); the largest number of table positions is :data:`linkage.model.MAX_POSITIONS`.
+#: grows with it); the largest number of table positions is :data:`linkage.model.mechanism.MAX_POSITIONS`.
 MAX_CYCLES = 1_000
 
 

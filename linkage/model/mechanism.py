@@ -7,7 +7,7 @@ x axis.
 
 Build one with :class:`MechanismBuilder` (the scheme loader uses the same builder), e.g.
 
->>> from linkage.model import MechanismBuilder
+>>> from linkage.model.mechanism import MechanismBuilder
 >>> b = MechanismBuilder("four_bar")
 >>> _ = b.link("0", points={"O": (0.0, 0.0), "C": (0.3, 0.0)})
 >>> _ = b.link("1", line=("O", "A"), length=0.1)
@@ -30,7 +30,7 @@ from typing import Any, Mapping
 
 import networkx as nx
 
-from .errors import SchemeError
+from ..errors import SchemeError
 from .input_laws import InputLaw, table_problems
 
 __all__ = [
@@ -255,7 +255,7 @@ class Mechanism:
     it, and computations over a full turn (cycle dynamics) refuse it. None: a full turn.
 
     ``input_laws`` maps each input link after the first to the law its angle follows as a function
-    of the first input's angle ``phi`` (:class:`~linkage.input_laws.InputLaw`; mobility W > 1).
+    of the first input's angle ``phi`` (:class:`~linkage.model.input_laws.InputLaw`; mobility W > 1).
 
     An input is named by a link or by a pair (:meth:`input_pair`): a link pinned to the frame is
     a crank (its angle is the coordinate); a link in a prismatic pair with the frame, or a
@@ -276,13 +276,23 @@ class Mechanism:
     input_range: tuple[float, float] | None = None
     input_laws: Mapping[str, InputLaw] = field(default_factory=dict)
 
-    @cached_property
+    #: What later stages derive from the mechanism alone and keep, by key (``"structure"``: its
+    #: decomposition; ``"plans"``: assembly plans; ``"extremes"``; ``"parts"``): computed on
+    #: first use, never part of the mechanism's identity (equality, hash) or its declaration.
+    cache: dict[str, Any] = field(default_factory=dict, init=False, repr=False, compare=False)
+
+    def __hash__(self) -> int:
+        """Hash of what names the mechanism, consistent with equality (equal mechanisms have
+        equal names, frames, inputs, links and pairs)."""
+        return hash((self.name, self.frame, self.inputs, tuple(sorted(self.links)), tuple(sorted(self.pairs))))
+
+    @property
     def parts(self) -> dict[str, Any]:
         """Typed parts parsed once from the further sections of ``extra`` (``"loads"`` ->
-        :class:`~linkage.forces.Loads`, ``"dynamics"`` -> :class:`~linkage.dynamics.DynamicsSpec`
-        or None): filled when a scheme is loaded, or on first use by
-        :func:`linkage.scheme.section_of`. Not part of the mechanism's identity (equality)."""
-        return {}
+        :class:`~linkage.kinetostatics.loads.Loads`, ``"dynamics"`` -> a ``DynamicsSpec`` or
+        None): filled when a scheme is loaded, or on first use by
+        :func:`linkage.model.scheme.section_of`; kept in :attr:`cache`."""
+        return self.cache.setdefault("parts", {})
 
     @cached_property
     def graph(self) -> nx.MultiGraph:
@@ -733,7 +743,7 @@ class MechanismBuilder:
                   table=None, degrees=()) -> "MechanismBuilder":
         """The angle of the further input ``link`` as a function of the first input's ``phi``:
         ``ratio * phi + phase`` (rad; defaults 1 and 0), or ``table=(phi, theta)``, two sequences of
-        angles (rad) interpolated by a cubic spline (see :class:`~linkage.input_laws.InputLaw`).
+        angles (rad) interpolated by a cubic spline (see :class:`~linkage.model.input_laws.InputLaw`).
         For a further input that is a slide, its slide (m) ``ratio * phi + phase`` (phase in m; no
         table). ``degrees``: the scheme keys given in degrees (``phase_deg``, ``table_deg``), which
         a slide refuses."""

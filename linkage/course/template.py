@@ -6,7 +6,7 @@ feasibility rules; any string value of the scheme that starts with ``=`` is an e
 parameters. The format is documented in ``docs/templates.md``; the shipped templates are in
 ``schemes/templates/``.
 
->>> from linkage.template import loads_template, draws
+>>> from linkage.course.template import loads_template, draws
 >>> t = loads_template('''
 ... name = "bar"
 ... input = "1"
@@ -50,8 +50,9 @@ from typing import Any
 
 import numpy as np
 
-from .errors import InputError, SchemeError
-from .model import Mechanism, unknown_keys
+from ..errors import InputError, SchemeError
+from ..model.mechanism import Mechanism, unknown_keys
+from ..model.scheme import _schemes_dirs, from_dict, read_text, shipped_or_path
 
 __all__ = [
     "DEFAULT_TASKS",
@@ -639,8 +640,8 @@ class Template:
         """The scheme of one variant as plain data, every expression replaced by its value.
 
         ``name`` (default: the template's name) becomes the scheme's name; its description is
-        the template's with the free values appended. :func:`linkage.scheme.from_dict` accepts
-        the result and :func:`linkage.scheme.toml_text` writes it as a plain scheme file.
+        the template's with the free values appended. :func:`linkage.model.scheme.from_dict` accepts
+        the result and :func:`linkage.model.scheme.toml_text` writes it as a plain scheme file.
         """
         env = self.values(free_values)
         free = {n: env[n] for n in self.free}
@@ -658,7 +659,7 @@ class Template:
         return f"{base} ({values})" if base and values else base or values
 
     def mechanism(self, free_values: Mapping[str, Any], name: str | None = None) -> Mechanism:
-        """The :class:`~linkage.model.Mechanism` of one variant (built by ``linkage.scheme.from_dict``).
+        """The :class:`~linkage.model.mechanism.Mechanism` of one variant (built by ``linkage.model.scheme.from_dict``).
 
         Raises
         ------
@@ -666,7 +667,6 @@ class Template:
             The variant's scheme is invalid; every problem is prefixed with the template and the
             free values.
         """
-        from .scheme import from_dict
 
         data = self.scheme_data(free_values, name)
         try:
@@ -775,7 +775,6 @@ def loads_template(text: str, source: str = "<string>") -> Template:
 
 def shipped_templates() -> dict[str, Path]:
     """Shipped template names -> files (``schemes/templates/*.toml``), sorted by name."""
-    from .scheme import _schemes_dirs
 
     found: dict[str, Path] = {}
     for folder in _schemes_dirs():
@@ -786,7 +785,6 @@ def shipped_templates() -> dict[str, Path]:
 
 def template_path(name_or_path: str | Path) -> Path:
     """The file of a shipped template name, or the given path."""
-    from .scheme import shipped_or_path
 
     return shipped_or_path(name_or_path, shipped_templates(), "template")
 
@@ -799,7 +797,6 @@ def load_template(name_or_path: str | Path) -> Template:
     SchemeError
         An unknown name, an unreadable file, or every problem of the template.
     """
-    from .scheme import read_text
 
     path = template_path(name_or_path)
     return loads_template(read_text(path, "template"), source=str(path))

@@ -8,7 +8,7 @@ or acceleration); a link's relative vectors join the images of its points; a sli
 relative slide along its guide and, on a turning guide, the Coriolis acceleration.
 
 >>> import numpy as np, linkage
->>> from linkage.plans import build_plans
+>>> from linkage.kinetostatics.plans import build_plans
 >>> mech = linkage.load("slider_crank")
 >>> plans = build_plans(linkage.analyze(mech, np.radians([30.0, 120.0]), omega=-10.0))
 >>> bool(np.allclose(plans.velocity.images["B"], plans.motion.velocity("B")))
@@ -28,10 +28,11 @@ import numpy as np
 
 from assur.base import OK, PrismaticJoint, RevoluteJoint, cross, perp
 
-from .errors import InputError
-from .forces import LoadTerm
-from .kinematics import Motion, table_positions_deg
-from .model import Prismatic, Revolute
+from ..errors import InputError
+from ..kinematics.motion import Motion, table_positions_deg
+from ..model.mechanism import Prismatic, Revolute
+from .loads import LoadTerm
+from .reactions import solve_reactions
 
 __all__ = ["POLE", "VELOCITY_KINDS", "ACCELERATION_KINDS", "PlanVector", "Plan", "PolygonForce", "PolygonMoment",
            "ForcePolygon", "LeverForce", "LeverMoment", "Lever", "Plans", "build_plans",
@@ -134,7 +135,7 @@ class PolygonForce:
     """A force of a force polygon: ``vector`` ``(N, 2)``, N, acting on ``link``.
 
     ``kind`` is ``gravity``, ``external``, ``driving``, ``inertia`` (the loads of
-    :mod:`linkage.forces`) or ``reaction``. A reaction's ``label`` is ``R[i,j]``, the force of
+    :mod:`linkage.kinetostatics.loads`) or ``reaction``. A reaction's ``label`` is ``R[i,j]``, the force of
     link j (``other``) on link i (docs/conventions.md), and ``pair`` its pair (the label ends
     with ``(pair)`` when several pairs join the two links); ``unknown`` marks the reactions the
     step finds (in pairs with the links placed before it), as opposed to the reactions of later
@@ -397,7 +398,6 @@ def build_plans(motion: Motion, reactions=None) -> Plans:
         a motion or reactions of only some links or pairs; a mechanism driven by a slide
         (:func:`require_crank_input`).
     """
-    from .kinetostatics import solve_reactions
 
     require_crank_input(motion.mechanism)
     if motion.omega is None or motion.second is None:

@@ -25,11 +25,11 @@ from numpy.typing import ArrayLike
 
 from assur.base import OK, RevoluteJoint, global_point, point_analogs
 
+from ..errors import AssemblyError, InputError
+from ..model.mechanism import Mechanism
+from ..structure import Structure, structure_of
 from .assembly import assembly_plans
-from .errors import AssemblyError, InputError
-from .kinematics import JUMP_CHECK_STEP, BranchWarning, Motion, _run_blocks, jump_steps, structure_of
-from .model import Mechanism
-from .structure import Structure
+from .motion import JUMP_CHECK_STEP, BranchWarning, Motion, _links_of, _run_blocks, jump_steps
 
 __all__ = ["OTHER_BRANCH", "VariantMotion", "analyze_variants", "geometry_of"]
 
@@ -188,7 +188,6 @@ def analyze_variants(
     otherwise. Groups that follow their motion through change points (``mode = "follow"``)
     are refused: their change points differ from variant to variant.
     """
-    from .kinematics import _links_of  # the shared parser of output names
 
     if order not in (0, 1, 2):
         raise InputError(f"order must be 0, 1 or 2, got {order!r}")

@@ -19,12 +19,21 @@ import tomllib
 from pathlib import Path
 from typing import Any, Callable, Mapping
 
-from .errors import LinkageError, SchemeError
-from .model import (MAX_ANGLE_DEG, MAX_MAGNITUDE, Mechanism, MechanismBuilder, Prismatic, Revolute, _angle,
-                    _is_number, unknown_keys)
+from ..errors import SchemeError
+from .mechanism import (
+    MAX_ANGLE_DEG,
+    MAX_MAGNITUDE,
+    Mechanism,
+    MechanismBuilder,
+    Prismatic,
+    Revolute,
+    _angle,
+    _is_number,
+    unknown_keys,
+)
 
 __all__ = ["load", "loads", "dumps", "save", "shipped_schemes", "scheme_path", "section_of",
-           "register_section", "SECTION_PARSERS"]
+           "register_section", "register_check", "SECTION_PARSERS", "LOAD_CHECKS"]
 
 TOP_KEYS = {"name", "description", "frame", "input", "inputs", "input_laws", "output", "links", "pairs",
             "assembly", "range", "range_deg"}
@@ -41,6 +50,20 @@ PAIR_KINDS = {"R": "R", "revolute": "R", "P": "P", "prismatic": "P"}
 SECTION_PARSERS: dict[str, Callable[[Mechanism, Any], tuple[Any, list[str]]]] = {}
 #: section -> the sections its parser reads (``loads`` reads the cycle of ``dynamics``)
 _REQUIRES: dict[str, tuple[str, ...]] = {}
+
+
+#: What a later stage checks of every mechanism loaded from a scheme, in order, before its further
+#: sections are parsed: ``check(mech, data)`` raises :class:`SchemeError` (its structure, that its
+#: groups assemble: registered by :mod:`linkage.kinematics.checks`).
+LOAD_CHECKS: list[Callable[[Mechanism, Mapping[str, Any]], None]] = []
+
+
+def register_check(check: Callable[[Mechanism, Mapping[str, Any]], None]) -> None:
+    """Run ``check(mech, data)`` on every mechanism loaded from a scheme (``data``: the parsed
+    file), after it is built and before its further sections are parsed; it raises
+    :class:`SchemeError` naming the problem."""
+    if check not in LOAD_CHECKS:
+        LOAD_CHECKS.append(check)
 
 
 def register_section(name: str, parser: Callable[[Mechanism, Any], tuple[Any, list[str]]],
@@ -106,7 +129,7 @@ def _schemes_dirs() -> list[Path]:
         dirs.append(Path(str(importlib.resources.files("linkage.schemes"))))
     except (ModuleNotFoundError, TypeError):
         pass
-    dirs.append(Path(__file__).resolve().parent.parent / "schemes")
+    dirs.append(Path(__file__).resolve().parents[2] / "schemes")
     return [d for d in dirs if d.is_dir()]
 
 
@@ -205,12 +228,10 @@ def from_dict(data: Mapping[str, Any], default_name: str = "mechanism") -> Mecha
     SchemeError
         Every problem of the first stage that has any.
     """
-    from .kinematics import assembly_branches, structure_of
-
     if "template" in data:
         raise SchemeError("this is an assignment template (it has a [template] table, and its values are "
                           "expressions of parameters), not a scheme: make variants of it with `linkage variants` "
-                          "or linkage.template.load_template (docs/templates.md)")
+                          "or linkage.course.template.load_template (docs/templates.md)")
     problems: list[str] = []
     extra_sections = {k: v for k, v in data.items() if k in SECTION_PARSERS}
     name = data.get("name", default_name)
@@ -264,15 +285,8 @@ def from_dict(data: Mapping[str, Any], default_name: str = "mechanism") -> Mecha
         raise SchemeError(problems + exc.problems) from None
     if problems:
         raise SchemeError(problems)
-    try:
-        structure_of(mech)
-        assembly_branches(mech)
-    except SchemeError:
-        raise
-    except LinkageError as exc:  # a wrong mobility, a group that never assembles ...
-        raise SchemeError(str(exc)) from None
-    if mech.input_range is not None:
-        _check_range_assembles(mech, data)
+    for check in LOAD_CHECKS:
+        check(mech, data)
     for section in _section_order():
         if section not in mech.parts:
             value, found = SECTION_PARSERS[section](mech, extra_sections.get(section))
@@ -303,47 +317,6 @@ def _input_range(data: Mapping[str, Any], problems: list[str]) -> tuple[float, f
                         f"(the input goes from a to b), got {raw!r}")
         return None
     return tuple(math.radians(v) for v in raw) if key == "range_deg" else (float(raw[0]), float(raw[1]))
-
-
-def _check_range_assembles(mech: Mechanism, data: Mapping[str, Any]) -> None:
-    """SchemeError naming the key, its value and the input angles of the declared range at which
-    the mechanism cannot be assembled (a range is where it assembles)."""
-    import numpy as np
-
-    from assur.base import CANNOT_ASSEMBLE, NOT_CONVERGED
-
-    from .kinematics import analyze, input_sweep
-
-    motion = input_sweep(mech)
-    phi = motion.phi
-    if np.any(motion.status == NOT_CONVERGED):   # a solver failure, not the range's: say so (ConvergenceError)
-        try:
-            analyze(mech, phi[motion.status == NOT_CONVERGED], order=0)
-        except LinkageError as exc:
-            raise SchemeError(str(exc)) from None
-    bad = np.flatnonzero(motion.status == CANNOT_ASSEMBLE)
-    if not len(bad):
-        return
-    key = "range_deg" if "range_deg" in data else "range"
-    coordinate = mech.coordinate
-    deg, unit = coordinate.shown(phi), coordinate.shown_unit
-    ok = np.flatnonzero(motion.status != CANNOT_ASSEMBLE)
-    runs = _runs(deg, bad)
-    assembles = f"; it assembles at {_runs(deg, ok)} {unit}" if len(ok) else "; it assembles nowhere in it"
-    raise SchemeError(f"{key} = {data[key]!r}: the mechanism cannot be assembled at {coordinate.symbol} = {runs} "
-                      f"{unit} of this range{assembles} (checked at {len(phi)} positions): declare a range within "
-                      "which it assembles")
-
-
-def _runs(deg, index) -> str:
-    """Consecutive sweep indices as ``a..b`` angle spans (deg), joined by commas."""
-    spans, start = [], index[0]
-    for prev, cur in zip(index, list(index[1:]) + [None]):
-        if cur is None or cur != prev + 1:
-            lo, hi = deg[start], deg[prev]
-            spans.append(f"{lo:.4g}" if start == prev else f"{lo:.4g}..{hi:.4g}")
-            start = cur
-    return ", ".join(spans)
 
 
 def _table(data, key, problems, where="") -> dict:

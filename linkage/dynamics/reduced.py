@@ -15,7 +15,7 @@ With ``s = sign(omega_m)`` and ``psi = s phi`` (the angle in the direction of ro
 - ``dI/dpsi = 2 s sum(m_k r'_Sk . r''_Sk + J_Sk theta_k' theta_k'')`` exact from the analogs.
 
 >>> import numpy as np, linkage
->>> from linkage.reduced import reduced_characteristics
+>>> from linkage.dynamics.reduced import reduced_characteristics
 >>> red = reduced_characteristics(linkage.load("four_bar"), np.linspace(0, 2 * np.pi, 5), rotation=1)
 >>> red.inertia.shape
 (5,)
@@ -30,10 +30,10 @@ from numpy.typing import ArrayLike
 
 from assur.base import point_analogs
 
-from .errors import DynamicsInputError
-from .forces import Loads, evaluate_loads, loads_of
-from .kinematics import analyze
-from .model import Mechanism
+from ..errors import DynamicsInputError
+from ..kinematics.motion import analyze
+from ..kinetostatics.loads import Loads, evaluate_loads, loads_of
+from ..model.mechanism import Mechanism
 
 __all__ = ["Reduced", "reduced_characteristics", "link_inertia_terms"]
 

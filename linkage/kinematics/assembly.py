@@ -1,7 +1,7 @@
 """Assembly modes: which closed-form branch each group takes at each input angle.
 
 A group with two assembly branches (RRR, RRP, RPR) is declared by a readable condition
-(``left_of``, ``towards`` ... see :class:`linkage.model.Assembly`). Where the group passes a
+(``left_of``, ``towards`` ... see :class:`linkage.model.mechanism.Assembly`). Where the group passes a
 singular position with both sides assembled -- a *change point*, such as the parallelogram
 four-bar's collinear position or the deltoid's coincident pivots -- its two assembly modes meet
 and the motion may go on in either. This module finds those points once per mechanism, on a
@@ -29,9 +29,10 @@ from scipy.optimize import minimize_scalar
 from assur.base import OK, SINGULAR, Group, GroupSolution, global_point
 from assur.generic import TRACE_JUMP, newton
 
-from .errors import SchemeError
-from .model import Mechanism
-from .structure import Structure
+from ..errors import SchemeError
+from ..model.mechanism import Mechanism
+from ..structure import Structure, structure_of
+from .inputs import input_poses
 
 __all__ = ["BranchPlan", "assembly_plans", "assembly_branches", "place_group", "BRANCH_SWEEP"]
 
@@ -187,9 +188,8 @@ def assembly_plans(mech: Mechanism) -> tuple[BranchPlan, ...]:
         group can be assembled at no input angle (the message names the group and the
         dimensional reason).
     """
-    from .kinematics import _cache, input_poses, structure_of
 
-    cache = _cache(mech)
+    cache = mech.cache
     if "plans" in cache:
         return cache["plans"]
     structure = structure_of(mech)
@@ -664,7 +664,6 @@ def _traced_change_points(mech, group, known, known_at, plan: BranchPlan, phi, r
 
 def _chain(mech, structure, plans, i, phi):
     """Poses of the known links of group ``i`` at the angles ``phi`` (earlier groups placed)."""
-    from .kinematics import input_poses
 
     poses = input_poses(mech, structure, phi)
     for j in structure.needed_groups(structure.groups[i].known_links):

@@ -1,6 +1,6 @@
 """Dynamics of a stroke: a slide input pushed by a force (a piston, a hydraulic cylinder).
 
-A crank's dynamics is periodic -- a cycle is a turn (:mod:`linkage.dynamics`). A slide input moves
+A crank's dynamics is periodic -- a cycle is a turn (:mod:`linkage.dynamics.pipeline`). A slide input moves
 over its stroke once, so its law of motion follows from the energy equation along the stroke
 (docs/inputs.md, "Dynamics of a stroke"): with ``s`` the slide, ``sigma = sign(s_end - s_start)``
 the sense of travel and ``w = |ds/dt|``,
@@ -8,7 +8,7 @@ the sense of travel and ``w = |ds/dt|``,
     1/2 m(s) w^2 = 1/2 m(s_0) w_0^2 + integral from s_0 to s of (sigma F + F_red) |ds|
 
 where ``m(s)`` is the reduced mass (kg) and ``F_red`` the reduced force of the declared loads
-along the travel (N), both from :func:`linkage.reduced.reduced_characteristics` (the crank's
+along the travel (N), both from :func:`linkage.dynamics.reduced.reduced_characteristics` (the crank's
 reduced inertia and moment, with analogs per m), and ``F`` the actuator's force along +s (N). The
 acceleration is ``d2s/dt2 = sigma (sigma F + F_red - m'(s) w^2 / 2) / m(s)`` and the time
 ``t = integral of |ds| / w`` (the mean of the two speeds on each step: exact for a constant
@@ -28,11 +28,11 @@ from typing import Callable
 import numpy as np
 from scipy.integrate import cumulative_trapezoid
 
-from .dynamics import _eps, _pick
-from .errors import DynamicsError, DynamicsInputError
-from .kinematics import analyze
-from .kinetostatics import Reactions, solve_reactions
-from .model import Mechanism
+from ..errors import DynamicsError, DynamicsInputError
+from ..kinematics.motion import analyze
+from ..kinetostatics.reactions import Reactions, solve_reactions
+from ..model.mechanism import Mechanism
+from .pipeline import _eps, _pick
 from .reduced import Reduced, reduced_characteristics
 
 __all__ = ["StrokeMotion", "stroke_motion", "SUBSTEPS"]
@@ -117,7 +117,7 @@ def stroke_motion(mech: Mechanism, force: float | Callable[[np.ndarray], np.ndar
     coordinate = mech.coordinate
     if coordinate.is_angle:
         raise DynamicsInputError(f"mechanism '{mech.name}': its input '{mech.inputs[0]}' is a crank; a stroke's "
-                                 "dynamics is for a slide input (the crank's dynamics: linkage.dynamics)")
+                                 "dynamics is for a slide input (the crank's dynamics: linkage.dynamics.pipeline)")
     if not (np.isfinite(initial_speed) and initial_speed >= 0):
         raise DynamicsInputError(f"initial_speed must be a finite speed >= 0 (m/s), got {initial_speed!r}")
     if isinstance(positions, bool) or not isinstance(positions, (int, np.integer)) or not 1 <= positions <= 100000:

@@ -19,7 +19,8 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from .errors import DynamicsInputError
+from ..errors import DynamicsInputError
+from ..model.mechanism import check_number, unknown_keys
 
 __all__ = ["ConstantMotor", "LinearMotor", "InductionMotor", "motor_from_spec", "starting_moment", "RPM"]
 
@@ -164,7 +165,6 @@ def motor_from_spec(spec: Mapping[str, Any]) -> tuple[Any | None, list[str]]:
     1e50 in magnitude, speeds, ratios, rated power and moment in [1e-50, 1e50], efficiency in
     (0, 1], overload in (1, 1e50], rated_rpm below synchronous_rpm.
     """
-    from .model import check_number, unknown_keys  # late: keep this module free of the model
 
     if not isinstance(spec, Mapping):
         return None, [f"motor: expected a table, got {spec!r}"]

@@ -21,16 +21,24 @@ from typing import Iterable, Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
-from assur.base import (ANALOG_TOL, CANNOT_ASSEMBLE, OK, SINGULAR, DrivenPrismaticJoint, global_point,
-                        point_analogs, rotate)
+from assur.base import (
+    ANALOG_TOL,
+    CANNOT_ASSEMBLE,
+    NOT_CONVERGED,
+    OK,
+    SINGULAR,
+    global_point,
+    point_analogs,
+)
 from assur.rows import frame, xy
 
-from .assembly import assembly_branches, assembly_plans, place_group
-from .errors import AssemblyError, InputError
-from .model import Mechanism, Prismatic
-from .structure import Structure, decompose
+from ..errors import AssemblyError, ConvergenceError, InputError
+from ..model.mechanism import Mechanism, Prismatic
+from ..structure import Structure, structure_of
+from .assembly import assembly_plans, place_group
+from .inputs import input_state
 
-__all__ = ["Motion", "analyze", "input_sweep", "SWEEP", "structure_of", "assembly_branches", "BranchWarning",
+__all__ = ["Motion", "analyze", "input_sweep", "SWEEP", "BranchWarning",
            "parse_quantity", "table_positions_deg", "angle_in_half_turn", "position_column"]
 
 
@@ -40,18 +48,6 @@ SWEEP = 361
 
 class BranchWarning(UserWarning):
     """A group changes assembly mode between analysed positions (it passes a singular position)."""
-
-
-def structure_of(mech: Mechanism) -> Structure:
-    """The (cached) decomposition of ``mech``."""
-    cache = _cache(mech)
-    if "structure" not in cache:
-        cache["structure"] = decompose(mech)
-    return cache["structure"]
-
-
-def _cache(mech: Mechanism) -> dict:
-    return mech.__dict__.setdefault("_analysis_cache", {})
 
 
 # ----------------------------------------------------------------------------------------------
@@ -326,7 +322,7 @@ def analyze(
     ----------
     mech : Mechanism
         The mechanism. With several input links, ``phi`` is the first one's angle and the others
-        follow their laws (:class:`~linkage.input_laws.InputLaw`); analogs are derivatives with
+        follow their laws (:class:`~linkage.model.input_laws.InputLaw`); analogs are derivatives with
         respect to ``phi``.
     phi : array_like, shape (N,) or scalar
         Input angles, rad (CCW from +x, docs/conventions.md); for a slide input (a piston, a
@@ -399,7 +395,7 @@ def input_sweep(mech: Mechanism) -> Motion:
     :data:`SWEEP` angles from 0 to 2 pi, or the declared input range; computed once per mechanism
     (load-time checks and drawings share it). Mode changes are left for the analyses that pass
     them to report."""
-    cache = _cache(mech)
+    cache = mech.cache
     if "sweep" not in cache:
         low, high = mech.input_range if mech.input_range is not None else (0.0, 2 * np.pi)
         with warnings.catch_warnings():
@@ -474,7 +470,7 @@ def _run_blocks(mech: Mechanism, structure: Structure, plans, group_ids: list[in
         view = {k: v[block] for k, v in poses.items()}
         view1 = None if first is None else {k: v[block] for k, v in first.items()}
         view2 = None if second is None else {k: v[block] for k, v in second.items()}
-        frames = _input_state(mech, structure, phi[block], view, view1, view2)
+        frames = input_state(mech, structure, phi[block], view, view1, view2)
         link_error = {k: 0.0 for k in view}
         for i in group_ids:
             group = structure.groups[i]
@@ -505,99 +501,13 @@ def _largest(values: list) -> np.ndarray | float:
     return out
 
 
-def _input_state(mech: Mechanism, structure: Structure, phi: np.ndarray, poses: dict, first: dict | None = None,
-                 second: dict | None = None) -> dict:
-    """Write the poses and analogs of the input links at the first input's angles ``phi`` into the
-    ``(N, 3)`` arrays of ``poses`` / ``first`` / ``second`` (the frame's are zeros; arrays are
-    allocated when missing). Returns the frames ``(x, y, c, s, theta)`` of the frame and the inputs."""
-    N = len(phi)
-    for d in (poses, first, second):
-        if d is not None:
-            if mech.frame not in d:
-                d[mech.frame] = np.zeros((N, 3))
-            for link in structure.inputs:
-                if link not in d:
-                    d[link] = np.empty((N, 3))
-    zeros = np.zeros(N)
-    frames = {mech.frame: (zeros, zeros, np.ones(N), zeros, zeros)}
-    for name, (q, rate, accel) in input_angles(mech, structure, phi).items():
-        joint = structure.input_joints[name]
-        out = poses[name]
-        if isinstance(joint, DrivenPrismaticJoint):    # a cylinder's driver: pose (s, 0, 0)
-            for values, d in ((q, poses), (rate, first), (accel, second)):
-                if d is not None:
-                    d[name][:, 0], d[name][:, 1:] = values, 0.0
-            frames[name] = (out[:, 0], zeros, np.ones(N), zeros, zeros)
-            continue
-        if joint.kind == "P":
-            _slider_state(joint, name, q, rate, accel, out, first and first[name], second and second[name])
-            c, s = np.cos(out[:, 2]), np.sin(out[:, 2])
-            frames[name] = (out[:, 0], out[:, 1], c, s, out[:, 2])
-            continue
-        p_input, _, p_frame = joint.local(name)
-        (px, py), (fx, fy) = xy(p_input), xy(p_frame)
-        c, s = np.cos(q), np.sin(q)
-        rx, ry = c * px - s * py, s * px + c * py
-        out[:, 0], out[:, 1], out[:, 2] = fx - rx, fy - ry, q
-        frames[name] = (out[:, 0], out[:, 1], c, s, out[:, 2])
-        if first is not None:
-            first[name][:, 0], first[name][:, 1], first[name][:, 2] = ry * rate, -rx * rate, rate
-        if second is not None:
-            # d2/dphi2 of fx - R(theta) p: rate^2 (R p) - accel (R p turned by 90 deg)
-            second[name][:, 0] = rx * rate**2 + ry * accel
-            second[name][:, 1] = ry * rate**2 - rx * accel
-            second[name][:, 2] = accel
-    return frames
-
-
-def _slider_state(joint, link: str, s, rate, accel, pose, first, second) -> None:
-    """Pose and analogs ``(N, 3)`` of an input ``link`` driven along a frame guide by the slide
-    ``s`` of its prismatic ``joint`` (rate ``ds/dphi`` and ``d2s/dphi2``): the slide ``s = u . d``
-    of :class:`assur.base.PrismaticJoint` solved for the link's pose, whether the guide is on the
-    frame (the link is the slider) or on the link (the frame's point slides in the link's guide)."""
-    if joint.b == link:             # guide on the frame: r = g + s u - Rot(beta) p
-        theta, sign = joint.beta, 1.0
-        u = np.asarray(joint.u, float)
-        start = np.asarray(joint.g, float) - rotate(theta, joint.p)
-    else:                           # guide on the link: r = p - Rot(-beta) g - s u
-        theta, sign = -joint.beta, -1.0
-        u = rotate(theta, joint.u)
-        start = np.asarray(joint.p, float) - rotate(theta, joint.g)
-    along = sign * np.asarray(s, float)
-    pose[:, 0], pose[:, 1], pose[:, 2] = start[0] + along * u[0], start[1] + along * u[1], theta
-    for analogs, value in ((first, rate), (second, accel)):
-        if analogs is not None:
-            analogs[:, 0], analogs[:, 1], analogs[:, 2] = sign * value * u[0], sign * value * u[1], 0.0
-
-
-def input_angles(mech: Mechanism, structure: Structure, phi: np.ndarray) -> dict[str, tuple]:
-    """Each input link's coordinate (its angle, rad, or its slide, m) and the coordinate's first and
-    second analogs ``(q, dq/dphi, d2q/dphi2)``, ``(N,)`` each, at the first input's coordinates
-    ``phi`` (the first input: ``phi``, 1, 0; further inputs: their
-    :class:`~linkage.input_laws.InputLaw`, declared under the input's name)."""
-    ones, zeros = np.ones(len(phi)), np.zeros(len(phi))
-    out = {}
-    for k, (name, declared) in enumerate(zip(structure.inputs, mech.inputs)):
-        out[name] = (phi, ones, zeros) if k == 0 else mech.input_laws[declared].angles(phi)
-    return out
-
-
-def input_poses(mech: Mechanism, structure: Structure, phi: np.ndarray) -> dict[str, np.ndarray]:
-    """Poses ``(N, 3)`` of the frame and the input link at the angles ``phi``."""
-    poses: dict[str, np.ndarray] = {}
-    _input_state(mech, structure, phi, poses)
-    return poses
-
-
 def _failure(mech: Mechanism, phi: np.ndarray, run: _Run, structure: Structure, plans, group_ids: list[int]
              ) -> AssemblyError:
     """The error of :func:`analyze` for the positions of ``run`` that are not OK, naming the input
     angles (deg) of each problem: :class:`ConvergenceError` when Newton's method did not converge
     for a group (its message also names the group and the closure residual at each such angle,
     recomputed there by :meth:`assur.generic.NewtonGroup.closure`), else :class:`AssemblyError`."""
-    from assur.base import NOT_CONVERGED
 
-    from .errors import ConvergenceError
 
     status, conditioning = run.status, run.conditioning
     parts = []
