@@ -112,7 +112,7 @@ def positions_only(mech: linkage.Mechanism, phi: np.ndarray) -> dict:
 
 def shaper_speed(mech: linkage.Mechanism) -> tuple[float, str]:
     """The shaper's declared mean speed (rad/s), or :data:`DEFAULT_SHAPER_SPEED`, and where it came from."""
-    from linkage.dynamics.pipeline import dynamics_of
+    from linkage.dynamics.spec import dynamics_of
     try:
         return float(dynamics_of(mech).mean_speed), "the scheme's [dynamics] mean_speed"
     except linkage.LinkageError as exc:

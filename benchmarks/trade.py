@@ -47,7 +47,7 @@ if str(ROOT) not in sys.path:  # run as a script from a checkout
 import linkage
 from assur import Group
 from assur.dyad import Dyad
-from linkage.dynamics.pipeline import course_method, dynamics_of, exact_method, steady_state
+from linkage.dynamics import course_method, dynamics_of, exact_method, steady_state
 from linkage.errors import AssemblyError, LinkageError, SchemeError
 from linkage.kinematics.motion import BranchWarning
 from linkage.dynamics.reduced import reduced_characteristics
@@ -168,24 +168,24 @@ def _smallest_good(counts: Sequence[int], errors: Sequence[float], target: float
 
 
 def _figure(height: float):
-    from linkage.report.plots import PAGE_WIDTH, _new_figure
+    from linkage.report.style import PAGE_WIDTH, new_figure
 
-    return _new_figure(PAGE_WIDTH, height)
+    return new_figure(PAGE_WIDTH, height)
 
 
 def _save(fig, path: Path | None) -> None:
-    from linkage.report.plots import _pyplot
+    from linkage.report.style import pyplot
 
     if path is not None:
         path.parent.mkdir(parents=True, exist_ok=True)
         fig.savefig(path, dpi=150)
-    _pyplot().close(fig)
+    pyplot().close(fig)
 
 
 def _loglog(ax, xlabel: str, ylabel: str) -> None:
     from matplotlib.ticker import NullFormatter
 
-    from linkage.report.plots import FONT, SMALL
+    from linkage.report.style import FONT, SMALL
 
     ax.set_xscale("log")
     ax.set_yscale("log")
@@ -204,7 +204,7 @@ def _slope(ax, x: np.ndarray, anchor: tuple[float, float], power: float, label: 
 
 
 def _legend_below(fig, axes, ncols: int = 2) -> None:
-    from linkage.report.plots import SMALL
+    from linkage.report.style import SMALL
 
     handles, labels = [], []
     for ax in axes:
@@ -242,7 +242,7 @@ class PositionsRow:
     n : int
         Table positions per revolution.
     seconds : float
-        Wall time of :func:`linkage.dynamics.pipeline.course_method`, s.
+        Wall time of :func:`linkage.dynamics.cycle.course_method`, s.
     work : float
         Cycle work of the resisting forces (gravity included), trapezoid on the n steps, J.
     driving : float
@@ -374,7 +374,7 @@ def positions_recommendation(study: dict[str, dict[str, Any]]) -> str:
 
 def positions_figure(study: dict[str, dict[str, Any]], path: Path | None) -> None:
     """Relative errors against n (log-log), one panel per scheme, and the time per n."""
-    from linkage.report.plots import CURVE_COLOURS, MARKERS, SMALL
+    from linkage.report.style import CURVE_COLOURS, MARKERS, SMALL
 
     fig = _figure(6.6)
     grid = fig.add_gridspec(2, len(study), height_ratios=[1.6, 1])
@@ -551,7 +551,7 @@ def quadrature_recommendation(study: dict[str, dict[str, Any]]) -> str:
 
 def quadrature_figure(study: dict[str, dict[str, Any]], path: Path | None) -> None:
     """Relative error of the cycle work against n (log-log) per rule, one panel per scheme."""
-    from linkage.report.plots import CURVE_COLOURS, MARKERS, SMALL
+    from linkage.report.style import CURVE_COLOURS, MARKERS, SMALL
 
     fig = _figure(4.6)
     axes = fig.subplots(1, len(study), squeeze=False)[0]
@@ -585,7 +585,7 @@ class MethodsResult:
 
     ``laws`` maps ``"course"``, ``"exact"``, ``"ode_course"`` (the steady state of the equation of
     motion with the course method's flywheel) and ``"ode_exact"`` (with the exact one) to
-    :class:`linkage.dynamics.pipeline.LawOfMotion` at ``fine`` positions (the course method at its declared n),
+    :class:`linkage.dynamics.cycle.LawOfMotion` at ``fine`` positions (the course method at its declared n),
     ``seconds`` to the wall time of each (s); ``n`` is the declared number of positions and
     ``stride`` picks them out of the ``fine`` ones.
     """
@@ -675,7 +675,9 @@ def methods_recommendation(study: dict[str, MethodsResult]) -> str:
 def methods_figure(study: dict[str, MethodsResult], path: Path | None) -> None:
     """The crank speed |omega| (rad/s) over the cycle by each method, one panel per scheme, table
     positions numbered along the top."""
-    from linkage.report.plots import CURVE_COLOURS, FONT, SMALL, _number_positions, _style_angle_axis, describe_column
+    from linkage.report.diagrams import number_positions, style_angle_axis
+    from linkage.report.style import CURVE_COLOURS, FONT, SMALL
+    from linkage.report.words import describe_column
 
     fig = _figure(7.4)
     axes = fig.subplots(len(study), 1, squeeze=False)[:, 0]
@@ -693,10 +695,10 @@ def methods_figure(study: dict[str, MethodsResult], path: Path | None) -> None:
                 label="equation of motion, steady state, with the course method's flywheel")
         wm = abs(dynamics_of(mech).mean_speed)
         ax.axhline(wm, color="0.3", lw=0.9, ls="-.", label="declared mean speed")
-        _style_angle_axis(ax, table_phi)
+        style_angle_axis(ax, table_phi)
         ax.set_ylabel("crank speed |ω|, rad/s", fontsize=FONT)
         ax.set_title(_nice(name), fontsize=SMALL + 1, loc="left")
-        _number_positions(ax, table_phi, np.arange(1, res.n + 2))
+        number_positions(ax, table_phi, np.arange(1, res.n + 2))
         ax.set_xlabel(describe_column("phi_deg", mech).axis, fontsize=FONT)
     _legend_below(fig, axes, ncols=1)
     _save(fig, path)
@@ -786,7 +788,7 @@ def tolerance_recommendation(study: dict[str, dict[str, Any]]) -> str:
 
 def tolerance_figure(study: dict[str, dict[str, Any]], path: Path | None) -> None:
     """Speed error and wall time of the steady state against rtol (log-log), one curve per scheme."""
-    from linkage.report.plots import CURVE_COLOURS, MARKERS
+    from linkage.report.style import CURVE_COLOURS, MARKERS
 
     fig = _figure(4.4)
     err_ax, time_ax = fig.subplots(1, 2)
@@ -1052,7 +1054,7 @@ def newton_recommendation(results: Sequence[NewtonResult]) -> str:
 def newton_figure(results: Sequence[NewtonResult], path: Path | None) -> None:
     """Newton's residual per step for each kind, and the time per position of the closed form and of
     Newton's method (batch, continuation)."""
-    from linkage.report.plots import CURVE_COLOURS, FONT, MARKERS, SMALL
+    from linkage.report.style import CURVE_COLOURS, FONT, MARKERS, SMALL
 
     fig = _figure(4.6)
     conv_ax, time_ax = fig.subplots(1, 2)
@@ -1177,7 +1179,7 @@ def analog_recommendation(rows: Sequence[AnalogRow]) -> str:
 def analog_figure(rows: Sequence[AnalogRow], path: Path | None) -> None:
     """The largest difference over the schemes against the step h (log-log), with the truncation and
     rounding slopes."""
-    from linkage.report.plots import CURVE_COLOURS, MARKERS
+    from linkage.report.style import CURVE_COLOURS, MARKERS
 
     fig = _figure(4.6)
     ax = fig.add_subplot()

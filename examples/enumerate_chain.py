@@ -21,7 +21,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 import linkage
-from linkage.research.enumeration import COLUMN_UNITS, enumerate_chain
+from linkage.research import COLUMN_UNITS, enumerate_chain
 from linkage.report import format_columns
 from linkage.report.plots import draw_mechanism
 

@@ -35,7 +35,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from linkage.kinetostatics.loads import LinkMoment, Loads, PointForce
-from linkage.model.mechanism import MechanismBuilder
+from linkage.model.builder import MechanismBuilder
 
 __all__ = ["KINDS", "DyadShape", "ChainShape", "Chain", "realize", "build", "oracle", "loads_of",
            "rot", "gpt", "wrap", "cross", "dot", "direction", "norm", "extent"]

@@ -14,7 +14,6 @@ import pytest
 import linkage
 from linkage.kinematics.batch import OTHER_BRANCH, analyze_variants, geometry_of
 from linkage.errors import InputError
-from linkage.kinematics.motion import BranchWarning
 
 SCHEMES = Path(__file__).resolve().parent.parent / "schemes"
 PHI = np.radians(np.arange(0.0, 360.0, 30.0))
@@ -104,6 +103,6 @@ def test_bad_geometry_is_refused_with_the_entry_named(geometry, message):
 def test_raise_mode_names_the_first_bad_variant():
     dims = np.array([[0.1, 0.3, 0.25, 0.3], [0.4, 0.3, 0.25, 0.3]])
     with warnings.catch_warnings():
-        warnings.simplefilter("ignore", BranchWarning)
+        warnings.simplefilter("error")      # no warning comes before the refusal
         with pytest.raises(linkage.AssemblyError, match="variant 1"):
             analyze_variants(linkage.load("four_bar"), PHI, four_bar_geometry(dims), on_failure="raise")

@@ -187,10 +187,9 @@ def test_a_jump_the_change_point_search_missed_is_still_reported():
     """Safety net: with the change point hidden from the plan, the deltoid's 4 m jump between two
     analysed angles 1 deg apart is reported by comparing the motion with its analogs."""
     from linkage.kinematics.assembly import BranchPlan
-    from linkage.kinematics.motion import _cache
 
     mech = linkage.loads(four_bar(1, 2, 2, 1, 'left_of = ["A", "C"]'))
-    _cache(mech)["plans"] = (BranchPlan(1, "keep", np.empty(0), np.empty(0, bool)),)
+    mech.cache["plans"] = (BranchPlan(1, "keep", np.empty(0), np.empty(0, bool)),)
     _, caught = _analyze(mech, np.radians([-1.5, -0.5, 0.5, 1.5]))
     assert len(caught) == 1 and "-0.5..0.5" in caught[0] and "II-RRR(2,3)" in caught[0]
     # and a smooth motion sampled just as finely, or coarsely, raises nothing

@@ -425,6 +425,39 @@ def test_bad_options_exit_2(capsys, options):
     assert code == 2 and out == "" and "Traceback" not in err
 
 
+@pytest.mark.parametrize("error, internal", [(ValueError("boom"), True),
+                                             (linkage.InputError("boom: a bad value"), False),
+                                             (linkage.AssemblyError("boom: cannot be assembled"), False)])
+def test_a_library_bug_is_an_internal_error_not_the_users(capsys, monkeypatch, error, internal):
+    """Only the ``LinkageError`` family (and argparse's errors) are the user's input: a bare
+    ``ValueError`` raised inside the library is a bug, said as such, with the internal status."""
+    import linkage.report.results
+    from linkage.cli import EXIT_INPUT, EXIT_INTERNAL
+
+    def broken(*args, **kwargs):
+        raise error
+
+    monkeypatch.setattr(linkage.report.results, "analyze", broken)   # what `linkage analyze` calls
+    code, out, err = run(capsys, "analyze", "four_bar")
+    assert out == "" and "Traceback" not in err
+    if internal:
+        assert code == EXIT_INTERNAL != EXIT_INPUT
+        assert err.strip() == ("linkage: error: internal error (ValueError: boom); please report it with the "
+                               "command line that caused it")
+    else:
+        assert code == EXIT_INPUT
+        assert err.strip() == f"linkage: error: {error}"
+
+
+def test_an_input_law_too_fast_to_resolve_is_the_users_error(capsys):
+    """A gear ratio of 1e15 leaves the further input's angle to round-off: the extreme positions
+    cannot be found, and the command says so as an error of the input (it once leaked scipy's
+    ValueError "f(a) and f(b) must have different signs")."""
+    code, out, err = run(capsys, "analyze", "five_bar_two_input", "--input-law", "4:1e15")
+    assert code == 2 and out == "" and "internal error" not in err and "Traceback" not in err
+    assert "extreme positions cannot be found" in err and "different signs" not in err
+
+
 LONG_CRANK = """
 name = "long_crank"
 input = "1"

@@ -34,7 +34,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # run from anywher
 import assur  # noqa: E402
 import linkage  # noqa: E402
 from assur import GROUP_KINDS, PrismaticJoint, RevoluteJoint  # noqa: E402
-from linkage.model.mechanism import MechanismBuilder  # noqa: E402
+from linkage.model.builder import MechanismBuilder  # noqa: E402
 
 _QUIET = [HealthCheck.filter_too_much, HealthCheck.too_slow]
 # no shrinking: a failure is reported as found (shrinking these nested draws can take minutes,

@@ -37,8 +37,9 @@ import numpy as np
 import pytest
 
 import linkage
-from linkage.dynamics.pipeline import (DynamicsError, DynamicsSpec, course_method, dynamics_of, exact_method,
-                              run_dynamics, simulate, steady_state)
+from linkage.dynamics import (DynamicsSpec, course_method, dynamics_of, exact_method, run_dynamics, simulate,
+                              steady_state)
+from linkage.errors import DynamicsError
 from linkage.kinetostatics.loads import Loads, PointForce
 from linkage.kinetostatics.reactions import solve_reactions, virtual_power_residual
 from linkage.dynamics.motors import RPM, ConstantMotor, InductionMotor, LinearMotor

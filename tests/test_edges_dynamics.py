@@ -30,9 +30,9 @@ import numpy as np
 import pytest
 
 import linkage
-from linkage.dynamics.pipeline import (DynamicsError, DynamicsInputError, DynamicsSpec, course_method, dynamics_of,
-                              exact_method, run_dynamics, simulate, steady_state)
-from linkage.errors import LinkageError
+from linkage.dynamics import (DynamicsSpec, course_method, dynamics_of, exact_method, run_dynamics, simulate,
+                              steady_state)
+from linkage.errors import DynamicsError, DynamicsInputError, LinkageError
 from linkage.kinetostatics.reactions import solve_reactions, virtual_power_residual
 from linkage.dynamics.motors import RPM, ConstantMotor, InductionMotor, LinearMotor
 from linkage.dynamics.reduced import reduced_characteristics

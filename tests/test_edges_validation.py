@@ -29,7 +29,7 @@ import pytest
 import linkage
 from _cli_io import run
 from linkage import InputError, LinkageError, SchemeError
-from linkage.dynamics.pipeline import dynamics_of
+from linkage.dynamics.spec import dynamics_of
 from linkage.kinetostatics.loads import StrokeDiagram, evaluate_loads, inertia_terms, loads_of
 from linkage.kinetostatics.reactions import solve_reactions
 from linkage.model.scheme import SECTION_PARSERS, from_dict, to_dict
@@ -301,7 +301,7 @@ def test_loads_and_dynamics_are_parsed_once_at_load_time(monkeypatch):
     assert loads_of(mech) is loads and dynamics_of(mech) is spec
     motion = linkage.analyze(mech, np.radians(np.arange(0.0, 360.0, 30.0)), omega=spec.mean_speed)
     solve_reactions(motion)
-    linkage.dynamics.pipeline.course_method(mech)
+    linkage.dynamics.course_method(mech)
     assert calls == []
     # a mechanism built in Python is parsed on first use, once
     built = mech.with_extra(loads={"gravity": [0.0, 0.0]})

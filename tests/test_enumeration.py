@@ -21,7 +21,7 @@ import linkage
 from assur.base import PrismaticJoint, RevoluteJoint
 from assur.generic import NewtonGroup
 from linkage.cli import main
-from linkage.research.enumeration import Enumeration, assignments, build_combination, enumerate_chain, measure
+from linkage.research import Enumeration, assignments, build_combination, enumerate_chain, measure
 from linkage.errors import InputError, StructureError
 from linkage.kinetostatics.reactions import solve_reactions
 from linkage.model.mechanism import Prismatic, Revolute

@@ -52,7 +52,7 @@ import pytest
 import linkage
 from assur.base import OK, global_point
 from linkage import LinkageError, SchemeError
-from linkage.dynamics.pipeline import course_method
+from linkage.dynamics.cycle import course_method
 from linkage.kinematics.motion import BranchWarning
 from linkage.kinetostatics.reactions import solve_reactions
 from linkage.model.mechanism import Prismatic, Revolute

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 from scipy.optimize import least_squares
 
@@ -127,8 +127,7 @@ def test_the_generic_solver_equals_the_closed_form_of_every_dyad(kind, data):
     poses, first, second = case.path(np.linspace(-0.5, 0.5, 11))
     exact = group.solve(poses, first, second, group.branches[0])
     ok = exact.status == OK
-    if not ok.any():
-        return
+    assume(ok.any())       # hypothesis counts and replaces a draw with nothing to compare
     known = {k: v[ok] for k, v in poses.items()}
     rng = np.random.default_rng(data.draw(st.integers(0, 2**31)))
     start = {k: v[ok] + rng.uniform(-1, 1, (int(ok.sum()), 3)) * [0.01 * case.size, 0.01 * case.size, 0.01]

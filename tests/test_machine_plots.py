@@ -18,7 +18,7 @@ from PIL import Image
 from scipy.integrate import cumulative_trapezoid, trapezoid
 
 import linkage
-from linkage.dynamics.pipeline import dynamics_of, run_dynamics
+from linkage.dynamics import dynamics_of, run_dynamics
 from linkage.errors import InputError
 from linkage.dynamics.reduced import reduced_characteristics
 from linkage.report.machine import (

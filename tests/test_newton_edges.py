@@ -270,8 +270,8 @@ def test_a_change_point_of_a_traced_triad_is_found_warned_and_singular():
     mech = linkage.loads(text)
     plan = assembly_plans(mech)[0]
     np.testing.assert_allclose(plan.change_points, [PHI_C], atol=1e-6)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", BranchWarning)
+    # the analysed angles lie at the change point: exactly that warning, naming the group and angle
+    with pytest.warns(BranchWarning, match=r"III\(2,3,4,5\) passes a change point at input angle\(s\) 100\.3 deg"):
         at = linkage.analyze(mech, [PHI_C, plan.change_points[0]], on_failure="mask")
     assert at.status.tolist() == [SINGULAR] * 2
 
@@ -321,7 +321,7 @@ def test_a_newton_failure_is_reported_by_the_tables_and_the_feasibility_check(mo
     verdict = check(mech)
     assert not verdict.feasible and verdict.rule == "solved" and "Newton's method did not converge" in verdict.reason
     monkeypatch.setattr(assur.generic, "NEWTON_STEPS", 1)
-    monkeypatch.setattr(linkage.cli, "load", lambda name: mech)    # its plan was traced with every step
+    monkeypatch.setattr(linkage.cli.options, "load", lambda name: mech)    # its plan was traced with every step
     code = main(["analyze", "class4", "--positions", "8", "--start", "0.5"])     # off the sweep's angles
     err = capsys.readouterr().err
     assert code == 0 and "did not converge" in err     # the rows stay, empty, with the warning

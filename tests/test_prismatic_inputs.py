@@ -328,15 +328,45 @@ def test_piston_json_header_does_not_show_the_slide_in_degrees(capsys):
     assert not wrong
 
 
-def test_piston_cli_range_is_a_stroke_in_m(capsys):
+def test_piston_cli_range_is_refused_naming_the_declared_stroke_in_m(capsys):
+    """``--range A B`` gives a crank's input angles (deg): for a slide input the command refuses it
+    (exit 2, nothing on stdout), naming the option and its values, the scheme, the input, and what
+    to use instead: the stroke the scheme declares, ``range = [s_start, s_end]`` in m."""
     code, out, err = run(capsys, "analyze", "piston_driven_crank", "--range", "0.45", "0.35", "--format", "csv",
                          "-n", "4")
-    if code != 0:                                   # a refusal naming the slide is right too
-        assert "m" in err and "range" in err
-        return
+    assert code == 2 and out == "" and "Traceback" not in err, err
+    assert ("--range 0.45 0.35: scheme 'piston_driven_crank' is driven by a slide (input '3'), analysed over the "
+            "stroke it declares (range = [s_start, s_end] in m); --range A B gives input angles (deg) for a crank"
+            ) in err, err
+
+
+def test_piston_declared_range_is_a_stroke_in_m(capsys, tmp_path):
+    """The stroke is chosen in the scheme instead: ``range = [0.45, 0.35]`` (m) gives the rows
+    s = 0.45 .. 0.35 m in 4 steps (from the command line and the Python API), and the positions and
+    analogs there are the closed form's."""
+    text = shipped_text("piston_driven_crank")
+    assert "range = [0.48, 0.32]" in text
+    scheme = tmp_path / "piston_short_stroke.toml"
+    scheme.write_text(text.replace("range = [0.48, 0.32]", "range = [0.45, 0.35]"), encoding="utf-8")
+    code, out, err = run(capsys, "analyze", scheme, "--format", "csv", "-n", "4")
+    assert code == 0, err
     table = read_csv(out)
-    np.testing.assert_allclose(table["s"], np.linspace(0.45, 0.35, 5), atol=1e-12)
-    np.testing.assert_allclose(table["1.theta"], piston_closed(table["s"])["1.theta"], atol=1e-12)
+    s_want = np.linspace(0.45, 0.35, 5)
+    np.testing.assert_allclose(table["s"], s_want, rtol=0, atol=1e-15)
+    closed = piston_closed(s_want)
+    for q in ("1.theta", "2.theta", "A.x", "A.y", "S2.x", "S2.y"):
+        np.testing.assert_allclose(table[q], closed[q], rtol=0, atol=1e-12, err_msg=q)
+    ex1, ex2 = piston_exact_analogs(s_want)
+    assert_close(table["1.theta'"], ex1, 1e-9, "CSV 1.theta'")
+    assert_close(table["1.theta''"], ex2, 1e-8, "CSV 1.theta''")
+
+    mech = linkage.load(scheme)
+    assert mech.input_range == (0.45, 0.35)
+    motion = linkage.analyze(mech, np.linspace(*mech.input_range, 5))
+    assert np.all(motion.status == 0)
+    np.testing.assert_allclose(motion.quantity("1.theta")[0], closed["1.theta"], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(motion.quantity("A.y")[0], closed["A.y"], rtol=0, atol=1e-12)
+    assert_close(motion.quantity("1.theta")[1], ex1, 1e-9, "1.theta' (Python API)")
 
 
 # ----------------------------------------------------------------------------------------------

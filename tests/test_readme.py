@@ -284,7 +284,7 @@ def test_readme_python_blocks_run(index, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)  # nothing written into the checkout
     code = _readme_blocks("python")[index]
     with warnings.catch_warnings(), contextlib.redirect_stdout(io.StringIO()):
-        warnings.simplefilter("ignore")
+        warnings.simplefilter("error")   # the examples run as written, without a warning a reader would meet
         exec(compile(code, f"README.md python block {index + 1}", "exec"), {"__name__": "__readme__"})
 
 
@@ -315,7 +315,7 @@ def test_readme_command_lines_run(command, tmp_path, monkeypatch):
 def test_docs_examples_run(doc, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
+        warnings.simplefilter("error")   # a warning fails its example (doctest reports it)
         result = doctest.testfile(str(doc), module_relative=False, encoding="utf-8", report=True,
                                   optionflags=doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE)
     assert result.failed == 0, f"{result.failed} of {result.attempted} examples of {_rel(doc)} fail (see above)"

@@ -59,7 +59,7 @@ import numpy as np
 import pytest
 
 import linkage
-from linkage.dynamics.pipeline import exact_method, run_dynamics, simulate, steady_state
+from linkage.dynamics import exact_method, run_dynamics, simulate, steady_state
 from linkage.dynamics.motors import RPM
 from linkage.model.scheme import from_dict, to_dict
 
@@ -167,7 +167,7 @@ def test_the_scaler_scales_what_dimensional_analysis_says(base_data):
     assert mech.links["2"].inertia == pytest.approx(12.0 * ref.links["2"].inertia, rel=1e-15)
     assert mech.size == pytest.approx(2.0 * ref.size, rel=1e-15)
     ws = math.sqrt(5.0 / 6.0)
-    spec, spec0 = linkage.dynamics.pipeline.dynamics_of(mech), linkage.dynamics.pipeline.dynamics_of(ref)
+    spec, spec0 = linkage.dynamics.dynamics_of(mech), linkage.dynamics.dynamics_of(ref)
     assert spec.mean_speed == pytest.approx(ws * spec0.mean_speed, rel=1e-15)
     assert spec.constant_inertia == pytest.approx(12.0 * spec0.constant_inertia, rel=1e-15)
 
@@ -239,7 +239,7 @@ def test_ode_steady_state_and_transient_scale_to_their_accuracy(base_data, ode_r
     assert_scaled(law.omega, law0.omega, ws, tol, "omega")
     assert_scaled(law.details["period"], law0.details["period"], 1 / ws, tol, "period")
     assert abs(law.delta_actual - law0.delta_actual) <= 2 * tol  # (w_max - w_min) / w_m
-    motor = linkage.dynamics.pipeline.dynamics_of(from_dict(base_data)).motor
+    motor = linkage.dynamics.dynamics_of(from_dict(base_data)).motor
     slip = 1 - np.mean(np.abs(law0.omega)) * motor.ratio / RPM / motor.synchronous_rpm  # operating slip
     assert 0 < slip < 0.05
     moment_tol = tol / slip  # through the motor: dM / M = (dw / w) / S

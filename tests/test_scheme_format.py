@@ -30,8 +30,8 @@ from scipy.optimize import brentq
 
 import linkage
 from linkage import InputError, SchemeError
-from linkage.dynamics.pipeline import (DynamicsError, DynamicsInputError, course_method, dynamics_of, exact_method,
-                              run_dynamics, simulate, steady_state)
+from linkage.dynamics import course_method, dynamics_of, exact_method, run_dynamics, simulate, steady_state
+from linkage.errors import DynamicsError, DynamicsInputError
 from linkage.kinetostatics.loads import diagram_value, evaluate_loads, loads_of
 from linkage.kinetostatics.reactions import solve_reactions
 from linkage.dynamics.motors import LinearMotor, starting_moment

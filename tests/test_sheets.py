@@ -33,10 +33,10 @@ from matplotlib.path import Path  # noqa: E402
 
 from linkage import MechanismBuilder  # noqa: E402
 from linkage.errors import InputError, LinkageError  # noqa: E402
-from linkage.report import sheets  # noqa: E402
+from linkage.course import sheets  # noqa: E402
 from linkage.report.plots import PlotExtraMissing  # noqa: E402
-from linkage.course.sheets import (ROWS_PER_PAGE, assignment_sheet, overview_figures, overview_pdf,  # noqa: E402
-                                   sheet_figures, standard_scale)
+from linkage.course.overview import ROWS_PER_PAGE, overview_figures, overview_pdf  # noqa: E402
+from linkage.course.sheets import assignment_sheet, sheet_figures, standard_scale  # noqa: E402
 from linkage.course.template import load_template  # noqa: E402
 
 ROOT = FilePath(__file__).resolve().parents[1]
@@ -155,11 +155,34 @@ def test_the_press_sheet_is_one_a4_page(press_pdf, press):
         assert "(A4)" in _poppler("pdfinfo", press_pdf)
 
 
-def test_the_shaper_sheet_is_one_or_two_a4_pages(shaper_pdf, shaper):
+def test_the_shaper_sheet_is_two_a4_pages(shaper_pdf, shaper):
+    """Two pages, because of what the sheet holds: the shaper's drawing is tall (the 0.6 m
+    rocker swings about pivots 0.17 m apart, the ram 0.36 m up), so the page's width draws it at
+    1:4 only with most of the page's height; its 15 data rows and 7 tasks under it would leave
+    the drawing about 1.75 in, less than MIN_DRAWING (2.6 in), at 1:20 -- more than one standard
+    step (a factor 2) below 1:4 -- so the data and the tasks go to page 2 and page 1 keeps the
+    drawing at 1:4. With only 3 data rows and 1 task the text fits under it: one page at 1:4.
+    (The press's flat slider-crank is drawn at 1:4 by the page's width with all its text under
+    it: one page, test_the_press_sheet_is_one_a4_page.)"""
+    assert len(shaper.data) == 15 and len(shaper.tasks) == 7
     pages = page_count(shaper_pdf)
-    assert pages in (1, 2)
-    assert media_boxes(shaper_pdf) == [pytest.approx(A4_PT, abs=0.01)] * pages
-    assert len(sheet_figures(shaper.mechanism, **shaper.kwargs())) == pages
+    assert pages == 2
+    assert media_boxes(shaper_pdf) == [pytest.approx(A4_PT, abs=0.01)] * 2
+    figures = sheet_figures(shaper.mechanism, **shaper.kwargs())
+    assert len(figures) == 2
+    first, second = figures
+    assert [ax.get_label() for ax in first.axes] == ["drawing"] and second.axes == []
+    assert figure_texts(first, "data-value") == [] and figure_texts(first, "task") == []
+    assert figure_texts(second, "title") == [f"{shaper.title} (continued)"]
+    assert figure_texts(second, "data-value") == [v for _, v, _ in shaper.data]
+    assert squeeze(" ".join(figure_texts(second, "task"))) == squeeze(" ".join(shaper.tasks))
+    # the drawing on page 1 is as large as the drawing alone: the text went to page 2 for it
+    assert figure_texts(first, "scale") == ["The mechanism to scale 1:4"]
+    alone = sheet_figures(shaper.mechanism, **{**shaper.kwargs(), "data": [], "tasks": []})
+    assert [figure_texts(f, "scale") for f in alone] == [["The mechanism to scale 1:4"]]
+    short = sheet_figures(shaper.mechanism, **{**shaper.kwargs(), "data": shaper.data[:3], "tasks": shaper.tasks[:1]})
+    assert [figure_texts(f, "scale") for f in short] == [["The mechanism to scale 1:4"]]
+    assert figure_texts(short[0], "data-value") == [v for _, v, _ in shaper.data[:3]]
 
 
 @pytest.mark.parametrize("which", ["press", "shaper"])

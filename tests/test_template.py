@@ -20,8 +20,8 @@ import linkage
 from linkage.dynamics.pipeline import run_dynamics
 from linkage.errors import InputError, SchemeError
 from linkage.model.scheme import from_dict, loads, shipped_schemes, toml_text
+from linkage.course.parameters import Parameter
 from linkage.course.template import (
-    Parameter,
     Template,
     draws,
     given_variants,

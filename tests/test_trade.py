@@ -210,7 +210,7 @@ def test_newton_reports_no_convergence():
 
 def test_methods_on_the_press():
     res = trade.methods_study([PRESS], repeat=1)[PRESS]
-    target = linkage.dynamics.pipeline.dynamics_of(linkage.load(PRESS)).delta
+    target = linkage.dynamics.dynamics_of(linkage.load(PRESS)).delta
     # no motor: the steady state under the balancing moment is the energy solution the exact
     # method sized, so it shows the target delta; the course flywheel (n = 12) is too small
     assert res.laws["ode_exact"].delta_actual == pytest.approx(target, rel=1e-3)

@@ -1,35 +1,23 @@
-"""Printable assignment sheets and the overview of a set of variants, as A4 PDF (matplotlib only).
+"""Printable assignment sheets: one variant's A4 PDF, the mechanism drawn to scale (matplotlib only).
 
-- :func:`assignment_sheet` -- one variant's sheet: the title and the mechanism in words, the
-  mechanism **drawn to a true standard scale** (1:1, 1:2, 1:2.5, 1:4, 1:5, 1:10 ... or 2:1, 5:1
-  ... for tiny mechanisms) at one table position with the sense of rotation of the input link, the
-  output point's path and the scale written out, so that a student measures lengths on the
-  printed page with a ruler; the data table and the numbered tasks. One A4 portrait page, two
-  when the text does not fit beside a drawing of useful size.
-- :func:`overview_pdf` -- the table of all variants of a course: A4 (landscape when the table is
-  wide), at most :data:`ROWS_PER_PAGE` rows a page, the header on every page, "page k of K", then
-  the notes.
-
-:func:`sheet_figures` and :func:`overview_figures` give the same pages as matplotlib figures
-(for a PNG, or to inspect them).
+:func:`assignment_sheet` -- one variant's sheet: the title and the mechanism in words, the
+mechanism **drawn to a true standard scale** (1:1, 1:2, 1:2.5, 1:4, 1:5, 1:10 ... or 2:1, 5:1
+... for tiny mechanisms) at one table position with the sense of rotation of the input link, the
+output point's path and the scale written out, so that a student measures lengths on the printed
+page with a ruler; the data table and the numbered tasks. One A4 portrait page, two when the
+text does not fit beside a drawing of useful size. :func:`sheet_figures` gives the same pages as
+matplotlib figures (for a PNG, or to inspect them). The overview of a set of variants is
+:mod:`~linkage.course.overview`'s; both are typeset with :mod:`~linkage.course.typesetting`.
 
 **To scale.** A4 is 210 x 297 mm and the figure is exactly that size, in inches; the drawing's
 axes are placed in inches and their limits set so that one metre of the mechanism is exactly
 ``scale / 0.0254`` inches of paper in x and in y. The sheet says "print at actual size": a
 printer's "fit to page" shrinks it (the 100 mm bar under the drawing checks the print).
 
-**Reproducible.** The same input gives byte-identical PDFs, whatever the current directory, the
-time or ``SOURCE_DATE_EPOCH``: the PDF carries no creation or modification date, a fixed
-producer and creator, fonts embedded as TrueType subsets (``pdf.fonttype`` 42, which also keeps
-the text searchable and extractable), and every page is laid out from matplotlib's built-in
-defaults (not the user's ``matplotlibrc``) at a fixed dpi. The bytes may differ between
-matplotlib or font versions.
-
-**Processes.** Figures are made with :class:`matplotlib.figure.Figure` and an Agg canvas of
-their own (to measure text), never through pyplot's global figure manager, and saved with the
-PDF backend; the functions can run in worker processes (not in threads of one process: the
-style is set through matplotlib's process-wide ``rcParams`` for the duration of a call). Without
-matplotlib they raise :class:`~linkage.report.plots.PlotExtraMissing`.
+**Reproducible.** The same input gives byte-identical PDFs (no dates, fixed metadata, embedded
+fonts, matplotlib's built-in defaults; see :mod:`~linkage.course.typesetting`), and the
+functions can run in worker processes. Without matplotlib they raise
+:class:`~linkage.report.style.PlotExtraMissing`.
 
 >>> import linkage
 >>> pdf = assignment_sheet(linkage.load("course_slider_crank"), title="Assignment 1 — press",
@@ -40,12 +28,10 @@ matplotlib they raise :class:`~linkage.report.plots.PlotExtraMissing`.
 
 from __future__ import annotations
 
-import io
 import math
-import re
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 
@@ -53,32 +39,12 @@ from ..errors import InputError
 from ..kinematics.motion import analyze
 from ..model.mechanism import Mechanism, Prismatic
 from ..model.scheme import section_of
-from ..report.plots import INSTALL_HINT, PlotExtraMissing, _Geometry, _rail_hatch, _support, draw_mechanism
+from ..report.drawing import Geometry, draw_mechanism, rail_hatch, support
 from ..report.results import declared_rotation, table_defaults, table_positions
+from .typesetting import (A4, BOTTOM, FOOT, HEADING, MM, SIDE, TABLE, TEXT, TITLE, TOP, Block, Measure, flow, footer,
+                          line_height, new_page, page_style, pdf_bytes, rule, shade, write)
 
-__all__ = ["assignment_sheet", "overview_pdf", "sheet_figures", "overview_figures", "standard_scale",
-           "scale_text", "table_motion", "ROWS_PER_PAGE", "A4"]
-
-#: A4 portrait, inches (210 x 297 mm)
-A4 = (210 / 25.4, 297 / 25.4)
-MM = 1 / 25.4          # inches per millimetre
-#: page margins, inches: left and right, top, bottom (the footer sits in the bottom margin)
-SIDE, TOP, BOTTOM = 15 * MM, 14 * MM, 16 * MM
-FOOTER_Y = 8 * MM       # baseline of the footer above the paper's bottom edge
-#: dpi of the figures (fixes the label placement of the drawing, which works in pixels)
-DPI = 100
-#: rows of the overview's table on one page at most
-ROWS_PER_PAGE = 35
-#: font sizes, points
-TITLE, HEADING, TEXT, TABLE, FOOT = 15, 11, 9.5, 9, 8
-#: line spacing, as a multiple of the font size
-LEADING = 1.28
-#: the fixed metadata of every PDF (no dates: see the module's docstring)
-PDF_METADATA = {"Creator": "linkage", "Producer": "linkage (matplotlib PDF backend)",
-                "CreationDate": None, "ModDate": None}
-#: the rcParams a page is laid out with, on top of matplotlib's built-in defaults
-SHEET_STYLE = {"pdf.fonttype": 42, "font.family": "DejaVu Sans", "axes.unicode_minus": True,
-         "pdf.compression": 6, "figure.dpi": DPI, "savefig.dpi": DPI}
+__all__ = ["assignment_sheet", "sheet_figures", "standard_scale", "scale_text", "table_motion"]
 
 # the drawing's box: room for the y tick labels and axis label at the left, the x ones below
 AXES_LEFT, AXES_RIGHT, AXES_BELOW, AXES_ABOVE = 0.62, 0.12, 0.46, 0.08
@@ -161,6 +127,7 @@ def scale_text(scale: tuple[float, float]) -> str:
     return ":".join(f"{v:.10g}" for v in scale)
 
 
+
 # ----------------------------------------------------------------------------------------------
 # the table positions of a scheme
 # ----------------------------------------------------------------------------------------------
@@ -184,218 +151,62 @@ def _rotation(mech: Mechanism) -> int | None:
     return spec.rotation if spec is not None else None
 
 
-# ----------------------------------------------------------------------------------------------
-# matplotlib without pyplot, text measured and wrapped
-# ----------------------------------------------------------------------------------------------
-
-
-def _matplotlib():
-    """The ``matplotlib`` module, or :class:`PlotExtraMissing` with the install hint."""
-    try:
-        import matplotlib
-        import matplotlib.backends.backend_agg  # noqa: F401
-        import matplotlib.backends.backend_pdf  # noqa: F401
-        import matplotlib.figure  # noqa: F401
-    except ImportError as exc:
-        raise PlotExtraMissing(INSTALL_HINT) from exc
-    return matplotlib
-
-
-def _style():
-    """A context with matplotlib's built-in defaults plus :data:`SHEET_STYLE` (undone on exit)."""
-    import contextlib
-
-    matplotlib = _matplotlib()
-
-    @contextlib.contextmanager
-    def context():
-        with matplotlib.rc_context():
-            matplotlib.rcdefaults()
-            matplotlib.rcParams.update(SHEET_STYLE)
-            yield
-
-    return context()
-
-
-def _page(landscape: bool = False):
-    """An empty A4 figure with its own Agg canvas (text measuring; no pyplot)."""
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-
-    size = A4[::-1] if landscape else A4
-    fig = Figure(figsize=size, dpi=DPI)
-    FigureCanvasAgg(fig)
-    return fig
-
-
-class _Measure:
-    """Widths of texts on paper, inches, from the Agg renderer of a high-dpi canvas."""
-
-    def __init__(self):
-        from matplotlib.backends.backend_agg import FigureCanvasAgg
-        from matplotlib.figure import Figure
-
-        self.renderer = FigureCanvasAgg(Figure(dpi=600)).get_renderer()
-        self._cache: dict[tuple[str, float, bool], float] = {}
-
-    def width(self, text: str, size: float, bold: bool = False) -> float:
-        from matplotlib.font_manager import FontProperties
-
-        key = (text, size, bold)
-        if key not in self._cache:
-            prop = FontProperties(size=size, weight="bold" if bold else "normal")
-            w, _, _ = self.renderer.get_text_width_height_descent(text, prop, ismath=False)
-            self._cache[key] = w / self.renderer.dpi
-        return self._cache[key]
-
-    def shortened(self, text: str, width: float, size: float) -> str:
-        """``text`` on one line no wider than ``width`` inches: cut with "…" when it is wider."""
-        text = " ".join(text.split())
-        if self.width(text, size) <= width:
-            return text
-        keep = max((k for k in range(len(text)) if self.width(text[:k].rstrip() + "…", size) <= width), default=0)
-        return text[:keep].rstrip() + "…"
-
-    def wrap(self, text: str, width: float, size: float, bold: bool = False) -> list[str]:
-        """``text`` in lines no wider than ``width`` inches, broken between words (inside a word
-        only when the word alone is wider); explicit newlines are kept."""
-        lines: list[str] = []
-        for paragraph in str(text).split("\n"):
-            line = ""
-            for word in paragraph.split():
-                candidate = f"{line} {word}" if line else word
-                if self.width(candidate, size, bold) <= width:
-                    line = candidate
-                    continue
-                if line:
-                    lines.append(line)
-                line = word
-                while self.width(line, size, bold) > width and len(line) > 1:
-                    cut = max(1, max(k for k in range(1, len(line) + 1)
-                                     if k == 1 or self.width(line[:k], size, bold) <= width))
-                    lines.append(line[:cut])
-                    line = line[cut:]
-            lines.append(line)
-        return lines
-
-
-def _line(size: float) -> float:
-    """Height of a line of text of ``size`` points, inches."""
-    return LEADING * size / 72
-
-
-#: height of the first baseline below the top of a line of text, as a multiple of the font size
-ASCENT = 0.82
-
-
-def _write(fig, x: float, y: float, text: str, size: float, *, bold: bool = False, ha: str = "left",
-           colour: str = "black", va: str = "top", gid: str | None = None) -> None:
-    """Text at (x, y) inches from the page's bottom-left corner, as written (no mathtext).
-
-    With ``va="top"`` (the default) ``y`` is the top of the first line and every line of the text
-    is placed on its own baseline, :data:`LEADING` apart, so that texts side by side (a number and
-    its item, the cells of a row) share their baselines whatever glyphs they hold.
-    """
-    w, h = fig.get_size_inches()
-    style = dict(fontsize=size, fontweight="bold" if bold else "normal", ha=ha, color=colour, parse_math=False,
-                 gid=gid)
-    if va != "top":
-        fig.text(x / w, y / h, text, va=va, **style)
-        return
-    for k, line in enumerate(text.split("\n")):
-        fig.text(x / w, (y - (ASCENT + LEADING * k) * size / 72) / h, line, va="baseline", **style)
-
-
-def _rule(fig, x0: float, x1: float, y: float, lw: float = 0.6, colour: str = "0.3") -> None:
-    from matplotlib.lines import Line2D
-
-    w, h = fig.get_size_inches()
-    fig.add_artist(Line2D([x0 / w, x1 / w], [y / h, y / h], lw=lw, color=colour, transform=fig.transFigure))
-
-
-def _shade(fig, x0: float, y0: float, width: float, height: float, colour: str = "0.93") -> None:
-    from matplotlib.patches import Rectangle
-
-    w, h = fig.get_size_inches()
-    fig.add_artist(Rectangle((x0 / w, y0 / h), width / w, height / h, fc=colour, ec="none",
-                             transform=fig.transFigure, zorder=-1))
-
-
-def _bytes_of(figures: Sequence[Any], title: str) -> bytes:
-    """The figures as the pages of one PDF, reproducibly (no dates, fixed producer)."""
-    from matplotlib.backends.backend_pdf import PdfPages
-
-    buffer = io.BytesIO()
-    with PdfPages(buffer, metadata={"Title": title, **PDF_METADATA}) as pdf:
-        for fig in figures:
-            pdf.savefig(fig)
-    return buffer.getvalue()
-
 
 # ----------------------------------------------------------------------------------------------
-# blocks of text on a page
+# the measured text of a sheet
 # ----------------------------------------------------------------------------------------------
-
-
-@dataclass(eq=False)
-class _Block:
-    """Something laid out down a page: its height, inches, and how to draw it from a top edge."""
-
-    height: float
-    draw: Callable[[Any, float], None]
-    gap: float = 0.16            # space below it, inches
 
 
 @dataclass
 class _Sheet:
     """The measured text of an assignment sheet."""
 
-    measure: _Measure
+    measure: Measure
     title: str
     subtitle: str
     data: list[tuple[str, str, str]]
     tasks: list[str]
     width: float = field(default=A4[0] - 2 * SIDE)
 
-    def heading(self, text: str) -> _Block:
+    def heading(self, text: str) -> Block:
         def draw(fig, top):
-            _write(fig, SIDE, top, text, HEADING, bold=True)
-        return _Block(_line(HEADING) + 0.04, draw, gap=0.02)
+            write(fig, SIDE, top, text, HEADING, bold=True)
+        return Block(line_height(HEADING) + 0.04, draw, gap=0.02)
 
-    def title_block(self) -> _Block:
+    def title_block(self) -> Block:
         title = self.measure.wrap(self.title, self.width, TITLE, bold=True)
         sub = self.measure.wrap(self.subtitle, self.width, TEXT) if self.subtitle.strip() else []
-        height = len(title) * _line(TITLE) + len(sub) * _line(TEXT) + (0.06 if sub else 0.0)
+        height = len(title) * line_height(TITLE) + len(sub) * line_height(TEXT) + (0.06 if sub else 0.0)
 
         def draw(fig, top):
-            _write(fig, SIDE, top, "\n".join(title), TITLE, bold=True, gid="title")
+            write(fig, SIDE, top, "\n".join(title), TITLE, bold=True, gid="title")
             if sub:
-                _write(fig, SIDE, top - len(title) * _line(TITLE) - 0.06, "\n".join(sub), TEXT, colour="0.15",
+                write(fig, SIDE, top - len(title) * line_height(TITLE) - 0.06, "\n".join(sub), TEXT, colour="0.15",
                        gid="subtitle")
-        return _Block(height, draw, gap=0.14)
+        return Block(height, draw, gap=0.14)
 
-    def data_block(self) -> _Block:
+    def data_block(self) -> Block:
         widths = self._data_columns()
         rows = [[self.measure.wrap(text, w - 0.12, TABLE) for text, w in zip(row, widths, strict=True)]
                 for row in self.data]
-        heights = [max(len(cell) for cell in row) * _line(TABLE) + 0.04 for row in rows]
-        head = _line(TABLE) + 0.07
+        heights = [max(len(cell) for cell in row) * line_height(TABLE) + 0.04 for row in rows]
+        head = line_height(TABLE) + 0.07
         x = [SIDE, SIDE + widths[0], SIDE + widths[0] + widths[1]]
 
         def draw(fig, top):
             for k, text in enumerate(("quantity", "value", "unit")):
-                _write(fig, x[k] + 0.06, top - 0.03, text, TABLE, bold=True)
+                write(fig, x[k] + 0.06, top - 0.03, text, TABLE, bold=True)
             y = top - head
-            _rule(fig, SIDE, SIDE + sum(widths), y, lw=0.8, colour="0.2")
+            rule(fig, SIDE, SIDE + sum(widths), y, lw=0.8, colour="0.2")
             for k, ((label, value, unit), h) in enumerate(zip(rows, heights, strict=True)):
                 if k % 2:
-                    _shade(fig, SIDE, y - h, sum(widths), h)
-                _write(fig, x[0] + 0.06, y - 0.025, "\n".join(label), TABLE, gid="data-label")
-                _write(fig, x[1] + 0.06, y - 0.025, "\n".join(value), TABLE, gid="data-value")
-                _write(fig, x[2] + 0.06, y - 0.025, "\n".join(unit), TABLE, gid="data-unit")
+                    shade(fig, SIDE, y - h, sum(widths), h)
+                write(fig, x[0] + 0.06, y - 0.025, "\n".join(label), TABLE, gid="data-label")
+                write(fig, x[1] + 0.06, y - 0.025, "\n".join(value), TABLE, gid="data-value")
+                write(fig, x[2] + 0.06, y - 0.025, "\n".join(unit), TABLE, gid="data-unit")
                 y -= h
-            _rule(fig, SIDE, SIDE + sum(widths), y, lw=0.8, colour="0.2")
-        return _Block(head + sum(heights) + 0.02, draw)
+            rule(fig, SIDE, SIDE + sum(widths), y, lw=0.8, colour="0.2")
+        return Block(head + sum(heights) + 0.02, draw)
 
     def _data_columns(self) -> tuple[float, float, float]:
         """Widths of the label, value and unit columns, inches: value and unit as wide as their
@@ -406,36 +217,18 @@ class _Sheet:
         value, unit = min(value + 0.3, self.width / 5), min(unit + 0.3, self.width / 6)
         return self.width - value - unit, value, unit
 
-    def tasks_block(self) -> _Block:
+    def tasks_block(self) -> Block:
         indent = self.measure.width(f"{len(self.tasks)}. ", TEXT) + 0.04
         items = [self.measure.wrap(t, self.width - indent, TEXT) for t in self.tasks]
-        heights = [len(lines) * _line(TEXT) + 0.05 for lines in items]
+        heights = [len(lines) * line_height(TEXT) + 0.05 for lines in items]
 
         def draw(fig, top):
             y = top
             for k, (lines, h) in enumerate(zip(items, heights, strict=True), start=1):
-                _write(fig, SIDE + indent - 0.04, y, f"{k}.", TEXT, ha="right")
-                _write(fig, SIDE + indent, y, "\n".join(lines), TEXT, gid="task")
+                write(fig, SIDE + indent - 0.04, y, f"{k}.", TEXT, ha="right")
+                write(fig, SIDE + indent, y, "\n".join(lines), TEXT, gid="task")
                 y -= h
-        return _Block(sum(heights), draw)
-
-
-def _flow(fig, blocks: Sequence[_Block], top: float) -> float:
-    """Draw the blocks down the page from ``top`` (inches); the top of what would come next."""
-    for block in blocks:
-        block.draw(fig, top)
-        top -= block.height + block.gap
-    return top
-
-
-def _footer(fig, measure: _Measure, left: str, right: str = "") -> None:
-    """The footer line: ``left`` (shortened with "…" when it would run into ``right``) and ``right``."""
-    width = fig.get_size_inches()[0]
-    room = width - 2 * SIDE - (measure.width(right, FOOT) + 0.3 if right else 0.0)
-    _write(fig, SIDE, FOOTER_Y, measure.shortened(left, room, FOOT), FOOT, colour="0.3", va="baseline",
-           gid="footer")
-    if right:
-        _write(fig, width - SIDE, FOOTER_Y, right, FOOT, colour="0.3", va="baseline", ha="right", gid="page-number")
+        return Block(sum(heights), draw)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -469,7 +262,7 @@ def _prepare_drawing(mech: Mechanism, position: int) -> _Drawing:
                          f"(0 is position 1, {n - 1} position {n}), got {position!r}")
     point = mech.output_point
     trajectories = [point] if point else []
-    geometry = _Geometry(motion, [int(position)], trajectories)
+    geometry = Geometry(motion, [int(position)], trajectories)
     scene = geometry.scene(int(position))
     return _Drawing(motion, int(position), trajectories, _drawn_bounds(motion, int(position), trajectories),
                     scene, geometry)
@@ -478,7 +271,7 @@ def _prepare_drawing(mech: Mechanism, position: int) -> _Drawing:
 def _drawn_bounds(motion, index: int, trajectories: list[str]) -> tuple[float, float, float, float]:
     """The data bounds (m) of every line and symbol ``draw_mechanism`` draws, from a draft without
     labels on a figure of its own."""
-    ax = _page().add_axes((0.1, 0.1, 0.8, 0.8))
+    ax = new_page().add_axes((0.1, 0.1, 0.8, 0.8))
     draw_mechanism(motion, index, ax, labels=False, trajectories=trajectories, caption=False)
     (x0, y0), (x1, y1) = ax.dataLim.get_points()
     return float(x0), float(x1), float(y0), float(y1)
@@ -532,21 +325,21 @@ def _axes_rect(drawing: _Drawing, scale: tuple[float, float], box_width: float, 
     return box_width, height, (cx - half_w, cx + half_w, cy - half_h, cy + half_h)
 
 
-def _drawing_block(sheet: _Sheet, drawing: _Drawing, scale: tuple[float, float]) -> _Block:
+def _drawing_block(sheet: _Sheet, drawing: _Drawing, scale: tuple[float, float]) -> Block:
     """The drawing at ``scale`` with its heading, caption and the 100 mm check bar."""
     width, height, limits = _axes_rect(drawing, scale, _box_width(sheet), MIN_AXES)
     heading = f"The mechanism to scale {scale_text(scale)}"
     caption = _caption_lines(sheet, drawing)
-    top_part = _line(HEADING) + 0.04 + len(caption) * _line(TABLE) + 0.04
+    top_part = line_height(HEADING) + 0.04 + len(caption) * line_height(TABLE) + 0.04
 
     def draw(fig, top):
-        _write(fig, SIDE, top, heading, HEADING, bold=True, gid="scale")
-        _write(fig, SIDE, top - _line(HEADING) - 0.04, "\n".join(caption), TABLE, gid="caption")
+        write(fig, SIDE, top, heading, HEADING, bold=True, gid="scale")
+        write(fig, SIDE, top - line_height(HEADING) - 0.04, "\n".join(caption), TABLE, gid="caption")
         axes_top = top - top_part - AXES_ABOVE
         _draw_axes(fig, drawing, limits, (SIDE + AXES_LEFT, axes_top - height, width, height))
         _check_bar(fig, axes_top - height - AXES_BELOW - 0.12)
 
-    return _Block(_drawing_overhead(sheet, drawing) + height, draw)
+    return Block(_drawing_overhead(sheet, drawing) + height, draw)
 
 
 def _box_width(sheet: _Sheet) -> float:
@@ -560,7 +353,7 @@ def _caption_lines(sheet: _Sheet, drawing: _Drawing) -> list[str]:
 
 def _drawing_overhead(sheet: _Sheet, drawing: _Drawing) -> float:
     """Height of the drawing's block without its axes, inches: heading, caption, tick labels, bar."""
-    return _line(HEADING) + 0.04 + len(_caption_lines(sheet, drawing)) * _line(TABLE) + 0.04 + AXES_ABOVE \
+    return line_height(HEADING) + 0.04 + len(_caption_lines(sheet, drawing)) * line_height(TABLE) + 0.04 + AXES_ABOVE \
         + AXES_BELOW + BAR
 
 
@@ -586,7 +379,7 @@ def _check_bar(fig, y: float) -> None:
         x = x0 + 10 * k * MM
         tick = 0.07 if k % 5 == 0 else 0.04
         fig.add_artist(Line2D([x / w, x / w], [(y - tick / 2) / h, (y + tick / 2) / h], lw=0.8, color="black"))
-    _write(fig, x1 + 0.1, y, "100 mm when printed at 100 % (actual size)", FOOT,
+    write(fig, x1 + 0.1, y, "100 mm when printed at 100 % (actual size)", FOOT,
            va="center_baseline", colour="0.25", gid="check-bar-note")
 
 
@@ -610,10 +403,10 @@ def _scene_segments(drawing: _Drawing) -> np.ndarray:
     lines = [np.vstack([poly, poly[:1]]) if len(poly) >= 3 else poly for _, poly in sc.bodies]
     lines += [line for _, line in sc.slots]
     for line, side in sc.rails:
-        surface, _ = _rail_hatch(line, side, u)
+        surface, _ = rail_hatch(line, side, u)
         lines += [line, surface]
     for p, direction in sc.pivots:
-        tri, ground, _ = _support(p, direction, u)
+        tri, ground, _ = support(p, direction, u)
         lines += [np.vstack([tri, tri[:1]]), ground]
     lines += [curve for _, _, curve in sc.trajectories]
     segs = [np.hstack([ln[:-1], ln[1:]]) for ln in lines if len(ln) >= 2]
@@ -691,6 +484,7 @@ def _rotation_arrow(ax, drawing: _Drawing) -> None:
                                  shrinkA=0, shrinkB=0))
 
 
+
 # ----------------------------------------------------------------------------------------------
 # the assignment sheet
 # ----------------------------------------------------------------------------------------------
@@ -719,8 +513,8 @@ def sheet_figures(mechanism: Mechanism, *, title: str, data: Sequence[tuple[str,
     gid is ``"scale"``. Each figure has an Agg canvas of its own: ``fig.savefig("page.png")``.
     """
     rows, task_list = _checked_sheet_input(title, data, tasks, subtitle)
-    with _style():
-        sheet = _Sheet(_Measure(), title, subtitle, rows, task_list)
+    with page_style():
+        sheet = _Sheet(Measure(), title, subtitle, rows, task_list)
         drawing = _prepare_drawing(mechanism, position)
         head = [sheet.title_block()]
         data_blocks = [sheet.heading("Data"), sheet.data_block()] if rows else []
@@ -734,13 +528,13 @@ def sheet_figures(mechanism: Mechanism, *, title: str, data: Sequence[tuple[str,
             _check_fits(blocks, k, len(rows), len(task_list))
         pages = []
         for blocks in page_blocks:
-            pages.append(_page())
-            _flow(pages[-1], blocks, A4[1] - TOP)
-            _footer(pages[-1], sheet.measure, title)
+            pages.append(new_page())
+            flow(pages[-1], blocks, A4[1] - TOP)
+            footer(pages[-1], sheet.measure, title)
     return pages
 
 
-def _check_fits(blocks: Sequence[_Block], page: int, rows: int, tasks: int) -> None:
+def _check_fits(blocks: Sequence[Block], page: int, rows: int, tasks: int) -> None:
     """InputError when the blocks run into the bottom margin of page ``page``."""
     height = sum(b.height + b.gap for b in blocks) - blocks[-1].gap
     room = A4[1] - TOP - BOTTOM
@@ -750,7 +544,7 @@ def _check_fits(blocks: Sequence[_Block], page: int, rows: int, tasks: int) -> N
                          "the labels or the tasks, or give fewer of them")
 
 
-def _arrangement(sheet: _Sheet, drawing: _Drawing, head: list[_Block], data: list[_Block], tasks: list[_Block]):
+def _arrangement(sheet: _Sheet, drawing: _Drawing, head: list[Block], data: list[Block], tasks: list[Block]):
     """``(blocks after the drawing on page 1, blocks of page 2, scale)``.
 
     One page when the room left by the text gives the drawing at least :data:`MIN_DRAWING` inches
@@ -761,11 +555,11 @@ def _arrangement(sheet: _Sheet, drawing: _Drawing, head: list[_Block], data: lis
     usable = A4[1] - TOP - BOTTOM - 0.1 - _drawing_overhead(sheet, drawing)
     box = _box_width(sheet)
 
-    def room(blocks: list[_Block]) -> float:
+    def room(blocks: list[Block]) -> float:
         """Height left for the drawing's axes with these blocks under it, inches (may be < 0)."""
         return usable - sum(b.height + b.gap for b in head + blocks)
 
-    def scale(blocks: list[_Block]) -> tuple[float, float]:
+    def scale(blocks: list[Block]) -> tuple[float, float]:
         return _fit_scale(drawing, box, max(room(blocks), MIN_AXES))
 
     widest = scale([])
@@ -821,272 +615,5 @@ def assignment_sheet(mechanism: Mechanism, *, title: str, data: Sequence[tuple[s
         matplotlib is not installed.
     """
     pages = sheet_figures(mechanism, title=title, data=data, tasks=tasks, subtitle=subtitle, position=position)
-    with _style():
-        return _bytes_of(pages, title)
-
-
-# ----------------------------------------------------------------------------------------------
-# the overview of all variants
-# ----------------------------------------------------------------------------------------------
-
-
-def _is_number(text: str) -> bool:
-    try:
-        float(text.replace("−", "-"))
-    except ValueError:
-        return False
-    return True
-
-
-@dataclass
-class _Table:
-    """The overview's table measured: font, column widths (inches), wrapped header and cells."""
-
-    font: float
-    widths: list[float]
-    header: list[list[str]]
-    cells: list[list[list[str]]]
-    right: list[bool]
-
-    @property
-    def width(self) -> float:
-        return sum(self.widths)
-
-
-PAD = 0.07   # inches of padding at each side of a cell
-
-
-def _measure_table(measure: _Measure, header: list[str], rows: list[list[str]], room: float) -> _Table:
-    """Column widths (inches) at the largest font from 9 pt down to 6 pt with which the table fits
-    ``room``: each column as wide as its widest cell and the widest piece of its name (names break
-    between words and after underscores), then whole names on one line while the room lasts; still
-    too wide at 6 pt, the columns share the room by their needs and cells wrap."""
-    right = [all(_is_number(r[c]) for r in rows if r[c].strip()) and any(r[c].strip() for r in rows)
-             for c in range(len(header))]
-    font = 9.0
-    while True:
-        cell = [max([measure.width(r[c], font) for r in rows] + [0.0]) for c in range(len(header))]
-        word = [max([measure.width(w, font, True) for w in _name_pieces(h)] + [0.0]) for h in header]
-        full = [measure.width(h, font, True) for h in header]
-        need = [max(c, w) + 2 * PAD for c, w in zip(cell, word, strict=True)]
-        if sum(need) <= room or font <= 6.0:
-            break
-        font -= 0.5
-    if sum(need) > room:
-        widths = [room * n / sum(need) for n in need]
-    else:                    # whole headers on one line, the cheapest first, while the room lasts
-        widths = list(need)
-        for extra, c in sorted((f + 2 * PAD - n, c) for c, (n, f) in enumerate(zip(need, full, strict=True))):
-            if 0 < extra <= room - sum(widths):
-                widths[c] += extra
-    spare = room - sum(widths)
-    if sum(widths) < room and spare < 0.5 * room:   # fill the page's width when it is nearly full
-        widths = [w + spare * w / sum(widths) for w in widths]
-    wrapped_header = [_wrap_name(measure, h, w - 2 * PAD, font) for h, w in zip(header, widths, strict=True)]
-    cells = [[measure.wrap(r[c], widths[c] - 2 * PAD, font) for c in range(len(header))] for r in rows]
-    return _Table(font, widths, wrapped_header, cells, right)
-
-
-def _name_pieces(name: str) -> list[str]:
-    """A column name cut where it may break: after spaces and after underscores
-    (``"min_transmission_angle_deg"`` -> ``min_``, ``transmission_``, ``angle_``, ``deg``)."""
-    return [piece for word in name.split() for piece in re.findall(r"[^_]+_*|_+", word)]
-
-
-def _wrap_name(measure: _Measure, name: str, width: float, size: float) -> list[str]:
-    """A column name (bold) in lines no wider than ``width`` inches, broken between words and
-    after underscores (inside a piece only when it alone is wider)."""
-    lines: list[str] = []
-    for word in name.split():
-        pieces = _name_pieces(word)
-        line = lines.pop() if lines and measure.width(f"{lines[-1]} {pieces[0]}", size, True) <= width else None
-        line = f"{line} " if line is not None else ""
-        for piece in pieces:
-            if line and measure.width(line + piece, size, True) > width:
-                lines.append(line.rstrip())
-                line = ""
-            line += piece
-        lines.append(line.rstrip())
-    return [part for line in lines for part in measure.wrap(line, width, size, True)] or [""]
-
-
-def _checked_overview_input(title, header, rows, notes) -> tuple[list[str], list[list[str]], list[str]]:
-    if not isinstance(title, str) or not title.strip():
-        raise InputError(f"the overview's title must be a non-empty string, got {title!r}")
-    header = list(header)
-    if not header or not all(isinstance(h, str) for h in header):
-        raise InputError(f"the overview's header must be a non-empty sequence of strings, got {header!r}")
-    checked = []
-    for k, row in enumerate(rows, start=1):
-        row = list(row) if not isinstance(row, str) else None
-        if row is None or len(row) != len(header) or not all(isinstance(c, str) for c in row):
-            raise InputError(f"overview row {k} must be {len(header)} strings (one per column of the header "
-                             f"{header}), got {rows[k - 1]!r}")
-        checked.append(row)
-    if isinstance(notes, str) or not all(isinstance(n, str) for n in notes):
-        raise InputError(f"the overview's notes must be a sequence of strings, got {notes!r}")
-    return header, checked, list(notes)
-
-
-def _pages_of_rows(heights: Sequence[float], room: float) -> list[list[int]]:
-    """Row indices per page: at most :data:`ROWS_PER_PAGE` rows and ``room`` inches a page."""
-    pages: list[list[int]] = [[]]
-    used = 0.0
-    for k, h in enumerate(heights):
-        if pages[-1] and (len(pages[-1]) >= ROWS_PER_PAGE or used + h > room):
-            pages.append([])
-            used = 0.0
-        pages[-1].append(k)
-        used += h
-    return pages
-
-
-def overview_figures(*, title: str, header: Sequence[str], rows: Sequence[Sequence[str]],
-                     notes: Sequence[str] = ()) -> list:
-    """The pages of :func:`overview_pdf` as A4 matplotlib figures, each with an Agg canvas of its
-    own."""
-    header, rows, notes = _checked_overview_input(title, header, rows, notes)
-    with _style():
-        return _overview_pages(title, header, rows, notes)
-
-
-def _overview_pages(title: str, header: list[str], rows: list[list[str]], notes: list[str]) -> list:
-    measure = _Measure()
-    portrait_room = A4[0] - 2 * SIDE
-    table = _measure_table(measure, header, rows, portrait_room)
-    landscape = table.width > portrait_room + 1e-9 or table.font < 9.0
-    if landscape:
-        table = _measure_table(measure, header, rows, A4[1] - 2 * SIDE)
-    page_w, page_h = (A4[1], A4[0]) if landscape else A4
-    line = _line(table.font)
-    head_h = max(len(h) for h in table.header) * line + 0.08
-    title_lines = measure.wrap(title, page_w - 2 * SIDE, HEADING + 2, bold=True)
-    title_h = len(title_lines) * _line(HEADING + 2) + 0.12
-    room = page_h - TOP - BOTTOM - title_h - head_h
-    row_h = max(min(room / ROWS_PER_PAGE, 1.55 * table.font / 72), line + 0.01)   # per line of a row
-    heights = [max(len(c) for c in cells) * row_h for cells in table.cells]
-    pages_rows = _pages_of_rows(heights, room) if rows else [[]]
-    note_lines = _note_lines(measure, notes, page_w - 2 * SIDE)
-    layout = _place_notes(pages_rows, heights, note_lines, room, page_h - TOP - BOTTOM - title_h)
-    figures = []
-    for k, (indices, notes_here) in enumerate(layout):
-        fig = _page(landscape)
-        top = page_h - TOP
-        _write(fig, SIDE, top, "\n".join(title_lines), HEADING + 2, bold=True, gid="title")
-        top -= title_h
-        if indices is not None:
-            top = _draw_table_page(fig, table, indices, heights, top, head_h)
-        if notes_here:
-            _draw_notes(fig, notes_here, top - 0.15)
-        _footer(fig, measure, title, f"page {k + 1} of {len(layout)}")
-        figures.append(fig)
-    return figures
-
-
-def _note_lines(measure: _Measure, notes: list[str], width: float) -> list[tuple[str, str]]:
-    """The notes as lines ``(text, kind)``, kind ``"heading"``, ``"first"`` (a note's first line,
-    with a bullet) or ``"more"``."""
-    if not notes:
-        return []
-    lines = [("Notes", "heading")]
-    for note in notes:
-        wrapped = measure.wrap(note, width - 0.25, TEXT)
-        lines += [(text, "first" if k == 0 else "more") for k, text in enumerate(wrapped)]
-    return lines
-
-
-def _place_notes(pages_rows, heights, note_lines, room, page_room):
-    """``[(row indices or None, note lines), ...]``: the table's pages, the notes after the last
-    row as far as they fit there, the rest on pages of their own."""
-    layout = [(indices, []) for indices in pages_rows]
-    if not note_lines:
-        return layout
-    used = sum(heights[k] for k in pages_rows[-1]) if pages_rows[-1] else 0.0
-    per_line = _line(TEXT)
-    extra = _line(HEADING) - per_line + 0.3     # the heading's larger line, the space above the notes
-    fit = max(0, int((room - used - extra) // per_line))
-    if fit >= min(3, len(note_lines)):
-        layout[-1] = (layout[-1][0], note_lines[:fit])
-        rest = note_lines[fit:]
-    else:
-        rest = note_lines
-    per_page = max(1, int((page_room - extra) // per_line))
-    for k in range(0, len(rest), per_page):
-        layout.append((None, rest[k:k + per_page]))
-    return layout
-
-
-def _draw_table_page(fig, table: _Table, indices: list[int], heights: list[float], top: float,
-                     head_h: float) -> float:
-    """The header and the rows ``indices``; the top of what comes below, inches."""
-    x = SIDE + np.concatenate([[0.0], np.cumsum(table.widths)])
-    line = _line(table.font)
-    for c, lines in enumerate(table.header):
-        anchor, ha = (x[c + 1] - PAD, "right") if table.right[c] else (x[c] + PAD, "left")
-        _write(fig, anchor, top - 0.03, "\n".join(lines), table.font, bold=True, ha=ha, gid="header",
-               va="top")
-    top -= head_h
-    _rule(fig, x[0], x[-1], top, lw=0.9, colour="0.15")
-    for n, k in enumerate(indices):
-        h = heights[k]
-        if n % 2:
-            _shade(fig, x[0], top - h, x[-1] - x[0], h)
-        for c, lines in enumerate(table.cells[k]):
-            anchor, ha = (x[c + 1] - PAD, "right") if table.right[c] else (x[c] + PAD, "left")
-            _write(fig, anchor, top - (h - len(lines) * line) / 2 - 0.005 * table.font / 9, "\n".join(lines),
-                   table.font, ha=ha, gid="cell")
-        top -= h
-    _rule(fig, x[0], x[-1], top, lw=0.9, colour="0.15")
-    return top
-
-
-def _draw_notes(fig, lines: list[tuple[str, str]], top: float) -> None:
-    for text, kind in lines:
-        if kind == "heading":
-            _write(fig, SIDE, top, text, HEADING, bold=True, gid="notes-heading")
-            top -= _line(HEADING)
-            continue
-        if kind == "first":
-            _write(fig, SIDE + 0.08, top, "•", TEXT)
-        _write(fig, SIDE + 0.25, top, text, TEXT, gid="note")
-        top -= _line(TEXT)
-
-
-def overview_pdf(*, title: str, header: Sequence[str], rows: Sequence[Sequence[str]],
-                 notes: Sequence[str] = ()) -> bytes:
-    """The table of all variants as an A4 PDF, then the notes.
-
-    Portrait when the table fits the width of a portrait page at 9 pt, else landscape (down to
-    6 pt, then the columns share the width and cells wrap). At most :data:`ROWS_PER_PAGE` rows a
-    page, the header on every page, columns of numbers right-aligned; a footer with the title and
-    "page k of K". The notes (e.g. how many draws each feasibility rule rejected) follow the last
-    row, on further pages when they do not fit.
-
-    Parameters
-    ----------
-    title : str
-        The overview's title; also the footer and the PDF's title.
-    header : sequence of str
-        The column names.
-    rows : sequence of sequences of str
-        One row of texts per variant, as many as the header has columns.
-    notes : sequence of str
-        Paragraphs after the table.
-
-    Returns
-    -------
-    bytes
-        The PDF; the same bytes for the same input (see the module's docstring).
-
-    Raises
-    ------
-    InputError
-        A row of another length than the header, or a value that is not text.
-    PlotExtraMissing
-        matplotlib is not installed.
-    """
-    pages = overview_figures(title=title, header=header, rows=rows, notes=notes)
-    with _style():
-        return _bytes_of(pages, title)
-
-
+    with page_style():
+        return pdf_bytes(pages, title)

@@ -37,7 +37,8 @@ from ..kinematics.feasibility import RULES, Requirements, Verdict, check, parse_
 from ..model.scheme import loads, toml_text
 from ..report.results import dynamics_results, forces_results, kinematics_results
 from ..report.tables import format_columns
-from .sheets import assignment_sheet, overview_pdf
+from .overview import overview_pdf
+from .sheets import assignment_sheet
 from .template import Template, draws, given_variants
 
 __all__ = ["Variant", "Selection", "select_variants", "build_variant", "write_variants", "VariantFailed",

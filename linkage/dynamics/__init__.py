@@ -1,25 +1,19 @@
 """Machine dynamics of a one-degree-of-freedom mechanism, from its kinetostatics.
 
 Reads the motion and the loads (:mod:`linkage.kinematics`, :mod:`linkage.kinetostatics`).
-Reduced moments and moment of inertia (:mod:`~.reduced`), motors reduced to the input
-(:mod:`~.motors`), the course pipeline with Mertsalov's and the exact cycle method, the equation
-of motion with a motor and its steady state (:mod:`~.pipeline`), the stroke of a slide input
+The ``[dynamics]`` section of a scheme and its checks (:mod:`~.spec`), reduced moments and moment
+of inertia (:mod:`~.reduced`), motors reduced to the input (:mod:`~.motors`), the law of motion
+over a cycle by Mertsalov's course method and the exact energy method (:mod:`~.cycle`), the
+equation of motion with a motor and its steady state (:mod:`~.equation`), the whole course
+pipeline with the coefficient of dynamics (:mod:`~.pipeline`), the stroke of a slide input
 (:mod:`~.stroke`).
 """
 
-from .pipeline import (
-                       DynamicsReport,
-                       DynamicsSpec,
-                       LawOfMotion,
-                       Transient,
-                       course_method,
-                       dynamics_of,
-                       exact_method,
-                       run_dynamics,
-                       simulate,
-                       steady_state,
-)
+from .cycle import LawOfMotion, course_method, exact_method
+from .equation import Transient, simulate, steady_state
+from .pipeline import DynamicsReport, run_dynamics
 from .reduced import Reduced, reduced_characteristics
+from .spec import DynamicsSpec, dynamics_of
 from .stroke import StrokeMotion, stroke_motion
 
 __all__ = ["DynamicsReport", "DynamicsSpec", "LawOfMotion", "Reduced", "StrokeMotion", "Transient", "course_method",

@@ -20,7 +20,7 @@ from typing import Any, Mapping
 import numpy as np
 
 from ..errors import DynamicsInputError
-from ..model.mechanism import check_number, unknown_keys
+from ..model.numbers import check_number, unknown_keys
 
 __all__ = ["ConstantMotor", "LinearMotor", "InductionMotor", "motor_from_spec", "starting_moment", "RPM"]
 

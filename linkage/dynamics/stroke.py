@@ -1,6 +1,6 @@
 """Dynamics of a stroke: a slide input pushed by a force (a piston, a hydraulic cylinder).
 
-A crank's dynamics is periodic -- a cycle is a turn (:mod:`linkage.dynamics.pipeline`). A slide input moves
+A crank's dynamics is periodic -- a cycle is a turn (:mod:`linkage.dynamics.cycle`). A slide input moves
 over its stroke once, so its law of motion follows from the energy equation along the stroke
 (docs/inputs.md, "Dynamics of a stroke"): with ``s`` the slide, ``sigma = sign(s_end - s_start)``
 the sense of travel and ``w = |ds/dt|``,
@@ -32,7 +32,7 @@ from ..errors import DynamicsError, DynamicsInputError
 from ..kinematics.motion import analyze
 from ..kinetostatics.reactions import Reactions, solve_reactions
 from ..model.mechanism import Mechanism
-from .pipeline import _eps, _pick
+from .cycle import angular_acceleration, reduced_at
 from .reduced import Reduced, reduced_characteristics
 
 __all__ = ["StrokeMotion", "stroke_motion", "SUBSTEPS"]
@@ -117,7 +117,7 @@ def stroke_motion(mech: Mechanism, force: float | Callable[[np.ndarray], np.ndar
     coordinate = mech.coordinate
     if coordinate.is_angle:
         raise DynamicsInputError(f"mechanism '{mech.name}': its input '{mech.inputs[0]}' is a crank; a stroke's "
-                                 "dynamics is for a slide input (the crank's dynamics: linkage.dynamics.pipeline)")
+                                 "dynamics is for a slide input (the crank's dynamics: linkage.dynamics.run_dynamics)")
     if not (np.isfinite(initial_speed) and initial_speed >= 0):
         raise DynamicsInputError(f"initial_speed must be a finite speed >= 0 (m/s), got {initial_speed!r}")
     if isinstance(positions, bool) or not isinstance(positions, (int, np.integer)) or not 1 <= positions <= 100000:
@@ -144,7 +144,7 @@ def stroke_motion(mech: Mechanism, force: float | Callable[[np.ndarray], np.ndar
     with np.errstate(divide="ignore"):
         steps = np.where(w[:-1] + w[1:] > 0, 2 * abs(s[1] - s[0]) / (w[:-1] + w[1:]), np.inf)
     t = np.concatenate([[0.0], np.cumsum(steps)])
-    accel = _eps(reduced, sense * pushed, reduced.inertia, w)      # the crank's formula, per m
+    accel = angular_acceleration(reduced, sense * pushed, reduced.inertia, w)      # the crank's formula, per m
     keep = slice(None, None, SUBSTEPS)
     return StrokeMotion(mech, s[keep], t[keep], sense * w[keep], accel[keep], pushed[keep].copy(),
-                        _pick(reduced, keep))
+                        reduced_at(reduced, keep))

@@ -34,7 +34,7 @@ from ..model.mechanism import Mechanism
 from ..structure import Structure, structure_of
 from .inputs import input_poses
 
-__all__ = ["BranchPlan", "assembly_plans", "assembly_branches", "place_group", "BRANCH_SWEEP"]
+__all__ = ["BranchPlan", "assembly_plans", "assembly_branches", "place_group", "random_start_modes", "BRANCH_SWEEP"]
 
 #: number of input angles of the sweep that resolves conditions and finds change points
 BRANCH_SWEEP = 360
@@ -453,7 +453,7 @@ SCAN = 8
 
 
 def _first_modes(group, known, size: float) -> tuple[int, dict[str, np.ndarray]]:
-    """The first sweep index where Newton's method from random starts (:func:`_multi_start`) finds
+    """The first sweep index where Newton's method from random starts (:func:`random_start_modes`) finds
     assembly modes, and the modes found there: index 0, else every :data:`SCAN`-th index, then
     back to the earliest index after the last one without modes (a group that does not assemble
     at the sweep's start is traced from where it does, instead of being taken for one that never
@@ -461,7 +461,7 @@ def _first_modes(group, known, size: float) -> tuple[int, dict[str, np.ndarray]]
     M = len(next(iter(known.values())))
 
     def at(m: int) -> dict[str, np.ndarray]:
-        return _multi_start(group, {k: v[m:m + 1] for k, v in known.items()}, size)
+        return random_start_modes(group, {k: v[m:m + 1] for k, v in known.items()}, size)
 
     def some(modes) -> bool:
         return len(next(iter(modes.values()))) > 0
@@ -482,12 +482,23 @@ def _first_modes(group, known, size: float) -> tuple[int, dict[str, np.ndarray]]
     return 0, at(0)
 
 
-def _multi_start(group, at0: dict[str, np.ndarray], size: float) -> dict[str, np.ndarray]:
-    """The distinct solutions ``{link: (C, 3)}`` Newton's method reaches from :data:`STARTS`
-    random starts at the known poses ``at0`` (one position)."""
+def random_start_modes(group, at0: dict[str, np.ndarray], size: float, around: dict[str, np.ndarray] | None = None,
+                       besides: dict[str, np.ndarray] | None = None) -> dict[str, np.ndarray]:
+    """The distinct assembly modes ``{link: (C, 3)}`` Newton's method reaches from :data:`STARTS`
+    random starts at one position, where the known links have the poses ``at0`` ``{link: (1, 3)}``.
+
+    The starts lie within ``size`` (m) in x and y of the centroid of the group's contact points
+    with its links at the poses ``around`` ``{link: (1, 3)}`` (default: each at the origin,
+    unturned), each link turned at random; the generator is seeded (0) at every call, so that the
+    same inputs give the same modes in the same order. A solution counts where Newton's method
+    converged and the group closes to 1e-9 of ``size``; it is a new mode when it lies farther than
+    1e-6 of ``size`` (:func:`poses_distance`) from every mode kept before it and from ``besides``
+    (a mode ``{link: (3,)}`` already known, not returned).
+    """
     rng = np.random.default_rng(0)
     known = {k: np.repeat(v, STARTS, axis=0) for k, v in at0.items()}
-    anchors = group.contact_points({**at0, **{k: np.zeros((1, 3)) for k in group.links}})
+    at = {k: np.zeros((1, 3)) for k in group.links} if around is None else around
+    anchors = group.contact_points({**at0, **at})
     centre = np.nanmean(anchors[0], axis=0)
     guesses = {k: np.column_stack([centre[0] + size * rng.uniform(-1, 1, STARTS),
                                    centre[1] + size * rng.uniform(-1, 1, STARTS),
@@ -498,9 +509,10 @@ def _multi_start(group, at0: dict[str, np.ndarray], size: float) -> dict[str, np
         good = np.flatnonzero(converged & (closure <= 1e-9 * size))
     kept: list[int] = []
     for n in good:
-        gap = poses_distance({k: v[n] for k, v in solved.items()}, {k: v[kept] for k, v in solved.items()},
-                             group.links, size)
-        if np.all(gap > 1e-6 * size):
+        candidate = {k: v[n] for k, v in solved.items()}
+        gap = poses_distance(candidate, {k: v[kept] for k, v in solved.items()}, group.links, size)
+        if np.all(gap > 1e-6 * size) and (besides is None
+                                          or poses_distance(candidate, besides, group.links, size) > 1e-6 * size):
             kept.append(int(n))
     return {k: v[kept] for k, v in solved.items()}
 

@@ -101,6 +101,21 @@ def extreme_positions(mech: Mechanism, quantity: str | None = None, *, samples: 
     return cache[key]
 
 
+def _analog_root(mech: Mechanism, quantity: str, derivative, a: float, b: float, xtol: float) -> float:
+    """The root of ``quantity``'s first analog between the sweep's input coordinates ``a`` and ``b``,
+    where the sweep found it changing sign; InputError when the analyses at ``a`` and ``b`` alone
+    do not confirm the change (the motion is not resolved there: e.g. an input law that turns a
+    further input too fast for float64)."""
+    try:
+        return brentq(derivative, a, b, xtol=xtol, rtol=4 * np.finfo(float).eps)
+    except ValueError:  # scipy: f(a) and f(b) must have different signs
+        ends = " and ".join(f"{v:.6g}" for v in mech.coordinate.shown([a, b]))
+        raise InputError(f"'{quantity}' of mechanism '{mech.name}': its first analog changes sign between the "
+                         f"input {mech.coordinate.kind}s {ends} {mech.coordinate.shown_unit} over the sweep, but "
+                         "not when analysed at these two alone: the motion is not resolved there (e.g. an input "
+                         "law with a huge ratio), so its extreme positions cannot be found") from None
+
+
 def _find_extremes(mech: Mechanism, quantity: str, samples: int, xtol: float) -> Extremes:
     def derivative(phi: float) -> float:
         return analyze(mech, [phi], order=1, outputs=[quantity]).quantity(quantity)[1][0]
@@ -123,7 +138,7 @@ def _find_extremes(mech: Mechanism, quantity: str, samples: int, xtol: float) ->
     valid = np.isfinite(d1) & np.isfinite(following)
     roots = list(grid[valid & (d1 == 0.0)])
     for i in np.flatnonzero(valid & (d1 * following < 0)):
-        roots.append(brentq(derivative, grid[i], grid[i] + step, xtol=xtol, rtol=4 * np.finfo(float).eps))
+        roots.append(_analog_root(mech, quantity, derivative, grid[i], grid[i] + step, xtol))
     if not roots:
         raise InputError(f"'{quantity}' of mechanism '{mech.name}' has no extreme position: its first "
                          "analog does not change sign over a revolution")
@@ -166,7 +181,7 @@ def _find_extremes_in_range(mech: Mechanism, quantity: str, samples: int, xtol: 
     valid = np.isfinite(d1[:-1]) & np.isfinite(d1[1:])
     roots = list(grid[np.flatnonzero(np.isfinite(d1) & (d1 == 0.0))])
     for i in np.flatnonzero(valid & (d1[:-1] * d1[1:] < 0)):
-        roots.append(brentq(derivative, grid[i], grid[i + 1], xtol=xtol, rtol=4 * np.finfo(float).eps))
+        roots.append(_analog_root(mech, quantity, derivative, grid[i], grid[i + 1], xtol))
     roots = np.unique(roots)
     candidates = np.concatenate([[lo, hi], roots])
     values = analyze(mech, candidates, order=0, outputs=[quantity], on_failure="mask").quantity(quantity)[0]

@@ -54,7 +54,8 @@ from assur.base import cross, point_analogs
 from ..errors import InputError, LinkageError, SchemeError
 from ..kinematics.extremes import extreme_positions, table_angles, wrap_angle
 from ..kinematics.motion import Motion, input_sweep, parse_quantity
-from ..model.mechanism import Mechanism, _angle, check_number, unknown_keys
+from ..model.mechanism import Mechanism
+from ..model.numbers import angle_from, check_number, unknown_keys
 from ..model.scheme import register_section, section_of
 
 __all__ = [
@@ -520,7 +521,7 @@ def _direction(mech: Mechanism, spec: Mapping[str, Any], where: str, problems: l
                         f"{link!r} (links: {sorted(mech.links)})")
         return False
     count = len(problems)
-    angle = _angle(spec, "angle", where, problems)
+    angle = angle_from(spec, "angle", where, problems)
     if len(problems) > count:
         return False
     return Direction(link=link, angle=angle)

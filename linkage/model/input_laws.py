@@ -45,7 +45,7 @@ class InputLaw:
     - any other table (spanning less than a turn) holds only within ``[phi_0, phi_n]``: the
       mechanism must declare an input range inside it, and analyses outside it are refused.
 
-    Build it through :meth:`linkage.model.mechanism.MechanismBuilder.input_law` (validated) or the scheme's
+    Build it through :meth:`linkage.model.builder.MechanismBuilder.input_law` (validated) or the scheme's
     ``[input_laws]`` table.
     """
 

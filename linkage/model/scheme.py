@@ -20,17 +20,9 @@ from pathlib import Path
 from typing import Any, Callable, Mapping
 
 from ..errors import SchemeError
-from .mechanism import (
-    MAX_ANGLE_DEG,
-    MAX_MAGNITUDE,
-    Mechanism,
-    MechanismBuilder,
-    Prismatic,
-    Revolute,
-    _angle,
-    _is_number,
-    unknown_keys,
-)
+from .builder import MechanismBuilder
+from .mechanism import Mechanism, Prismatic, Revolute
+from .numbers import MAX_ANGLE_DEG, MAX_MAGNITUDE, angle_from, is_number, unknown_keys
 
 __all__ = ["load", "loads", "dumps", "save", "shipped_schemes", "scheme_path", "section_of",
            "register_section", "register_check", "SECTION_PARSERS", "LOAD_CHECKS"]
@@ -123,7 +115,8 @@ def section_of(mech: Mechanism, name: str) -> Any:
     return parts[name]
 
 
-def _schemes_dirs() -> list[Path]:
+def schemes_dirs() -> list[Path]:
+    """The folders that hold the shipped schemes (the installed package's, the source tree's)."""
     dirs = []
     try:
         dirs.append(Path(str(importlib.resources.files("linkage.schemes"))))
@@ -136,7 +129,7 @@ def _schemes_dirs() -> list[Path]:
 def shipped_schemes() -> dict[str, Path]:
     """Shipped scheme names -> files, sorted by name."""
     found: dict[str, Path] = {}
-    for d in _schemes_dirs():
+    for d in schemes_dirs():
         for f in sorted(d.glob("*.toml")):
             found.setdefault(f.stem, f)
     return dict(sorted(found.items()))
@@ -312,7 +305,7 @@ def _input_range(data: Mapping[str, Any], problems: list[str]) -> tuple[float, f
     raw = data[key]
     largest = MAX_ANGLE_DEG if key == "range_deg" else MAX_MAGNITUDE
     unit = "deg" if key == "range_deg" else "rad (m for a slide input)"
-    if not (isinstance(raw, list) and len(raw) == 2 and all(_is_number(v) and abs(v) <= largest for v in raw)):
+    if not (isinstance(raw, list) and len(raw) == 2 and all(is_number(v) and abs(v) <= largest for v in raw)):
         problems.append(f"{key}: expected [a, b], two input coordinates in {unit} with |x| <= {largest:.6g} "
                         f"(the input goes from a to b), got {raw!r}")
         return None
@@ -368,7 +361,7 @@ def _add_pair(builder, name, spec, problems, link_names=None) -> bool:
                         f"'at' (a point of slider link '{links[1]}')")
         return False
     count = len(problems)
-    angle = _angle(spec, "angle", where, problems)
+    angle = angle_from(spec, "angle", where, problems)
     if len(problems) > count:
         return False
     builder.prismatic(name, links[0], links[1], guide=spec["guide"], at=spec["at"], angle=angle)
@@ -384,8 +377,8 @@ def _add_assembly(builder, point, spec, problems):
     if unknown_keys(spec, known, where, problems):
         return  # one message: the misspelt key, not the condition it leaves incomplete
     count = len(problems)
-    towards = _angle(spec, "towards", where, problems, default=None)
-    phi = _angle(spec, "phi", where, problems, default=None)
+    towards = angle_from(spec, "towards", where, problems, default=None)
+    phi = angle_from(spec, "phi", where, problems, default=None)
     if len(problems) > count:
         return
     builder.assembly(point, left_of=spec.get("left_of"), right_of=spec.get("right_of"),
@@ -403,7 +396,7 @@ def _add_input_law(builder, link, spec, problems):
     if unknown_keys(spec, {"ratio", "phase", "phase_deg", "table", "table_deg"}, where, problems):
         return
     count = len(problems)
-    phase = _angle(spec, "phase", where, problems, default=None)
+    phase = angle_from(spec, "phase", where, problems, default=None)
     if "table" in spec and "table_deg" in spec:
         problems.append(f"{where}: give either 'table' (rad) or 'table_deg' (deg), not both")
     if len(problems) > count:
@@ -412,7 +405,7 @@ def _add_input_law(builder, link, spec, problems):
     table = None
     if raw is not None:
         key = "table_deg" if "table_deg" in spec else "table"
-        if not (isinstance(raw, list) and all(isinstance(row, list) and len(row) == 2 and all(map(_is_number, row))
+        if not (isinstance(raw, list) and all(isinstance(row, list) and len(row) == 2 and all(map(is_number, row))
                                               for row in raw)):
             problems.append(f"{where}: {key} must be a list of pairs [phi, theta] of numbers, got {raw!r}")
             return

@@ -41,27 +41,25 @@ from ..kinematics.extremes import table_angles
 from ..kinematics.motion import Motion, analyze
 from ..model.mechanism import Mechanism
 from ..model.scheme import section_of
-from .plots import (
-    _SUPPORT_DIRECTIONS,
-    CAPTION_CHARS,
-    FONT,
+from .drawing import (
     PIN,
-    _add_artists,
-    _draw_scene,
-    _figure_for,
-    _Geometry,
-    _hull,
-    _inside,
-    _limits,
-    _moving_artists,
-    _obstacles,
-    _place_labels,
-    _pyplot,
-    _samples,
-    _Scene,
-    _support,
-    _trajectory_note,
+    SUPPORT_DIRECTIONS,
+    Geometry,
+    Scene,
+    add_artists,
+    convex_hull,
+    draw_scene,
+    drawing_limits,
+    figure_for,
+    moving_artists,
+    place_point_labels,
+    scene_obstacles,
+    scene_samples,
+    support,
 )
+from .labels import points_inside
+from .style import FONT, pyplot
+from .words import CAPTION_CHARS, trajectory_note
 
 __all__ = ["Film", "default_trajectories", "film_angles", "write_animation"]
 
@@ -213,7 +211,7 @@ class Film:
     def __init__(self, motion_or_mechanism: Motion | Mechanism, frames: int = 72, *,
                  trajectories: Sequence[str] | None = None, dpi: float = 80.0,
                  labels: bool | Sequence[str] = True):
-        _pyplot()
+        pyplot()
         from matplotlib.backends.backend_agg import FigureCanvasAgg
 
         _check_dpi(dpi)
@@ -223,18 +221,18 @@ class Film:
         self.trajectories = default_trajectories(mech) if trajectories is None else list(trajectories)
         self.labels = labels
         self.motion = _assembled_motion(mech, self.angles)
-        self.geometry = _Geometry(self.motion, range(frames), self.trajectories)
+        self.geometry = Geometry(self.motion, range(frames), self.trajectories)
         self.scenes = _scenes(self.geometry, frames)
-        self.limits = _limits(self.scenes, self.geometry)
+        self.limits = drawing_limits(self.scenes, self.geometry)
         self.captions = _captions([self._caption(k) for k in range(frames)])
         lines = self.captions[0].count("\n") + 1
         chars = max(len(line) for c in self.captions for line in c.splitlines())
-        self.figure, rects = _figure_for(self.limits, caption_lines=lines, text_chars=chars)
+        self.figure, rects = figure_for(self.limits, caption_lines=lines, text_chars=chars)
         self.figure.set_dpi(dpi)
         FigureCanvasAgg(self.figure)          # pixels of its own, whatever pyplot's backend
         self.ax = self.figure.add_axes(rects[0])
-        _draw_scene(self.ax, _still(self.scenes[0]), self.geometry, self.limits, False, "")
-        self._still_obstacles = _obstacles(_still(self.scenes[0]), self.geometry.unit, trajectory_step=3)
+        draw_scene(self.ax, _still(self.scenes[0]), self.geometry, self.limits, False, "")
+        self._still_obstacles = scene_obstacles(_still(self.scenes[0]), self.geometry.unit, trajectory_step=3)
         self._moving: list = []
         self._background = None
         self._renderer = None
@@ -256,12 +254,12 @@ class Film:
         for artist in self._moving:
             artist.remove()
         sc, u = self.scenes[k], self.geometry.unit
-        moving = _add_artists(self.ax, _moving_artists(sc, self.geometry))
+        moving = add_artists(self.ax, moving_artists(sc, self.geometry))
         if self.labels:
-            drawn = _obstacles(_moving_part(sc), u, self._still_obstacles, trajectory_step=3)
+            drawn = scene_obstacles(_moving_part(sc), u, self._still_obstacles, trajectory_step=3)
             before = set(self.ax.texts)
             wanted = list(sc.points) if self.labels is True else [n for n in self.labels if n in sc.points]
-            _place_labels(self.ax, sc, wanted, drawn, FONT, PIN * u)
+            place_point_labels(self.ax, sc, wanted, drawn, FONT, PIN * u)
             moving += [t for t in self.ax.texts if t not in before]
         moving.append(self.ax.annotate(self.captions[k], (0.0, 1.0), xycoords="axes fraction", xytext=(0, TITLE_PAD),
                                        textcoords="offset points", ha="left", va="baseline", fontsize=FONT,
@@ -287,12 +285,12 @@ class Film:
 
     def close(self) -> None:
         """Close the figure."""
-        _pyplot().close(self.figure)
+        pyplot().close(self.figure)
 
     def _caption(self, k: int) -> str:
         """The input angle of frame k in words: where the input link is, how far it has turned
         from position 1 (or which way it moves over a range), and what the dashed lines are;
-        lines of at most :data:`~linkage.report.plots.CAPTION_CHARS` characters."""
+        lines of at most :data:`~linkage.report.words.CAPTION_CHARS` characters."""
         import textwrap
 
         mech = self.motion.mechanism
@@ -311,7 +309,7 @@ class Film:
             a, b = np.degrees(mech.input_range)
             moved = f"on its way back from {b:.4g}° to {a:.4g}°" if 2 * k > len(self) else \
                 f"on its way from {a:.4g}° to {b:.4g}°"
-        note = textwrap.wrap(_trajectory_note(mech, self.trajectories), CAPTION_CHARS) if self.trajectories else []
+        note = textwrap.wrap(trajectory_note(mech, self.trajectories), CAPTION_CHARS) if self.trajectories else []
         return "\n".join(head + [moved] + note)
 
 
@@ -328,7 +326,7 @@ def _captions(texts: list[str]) -> list[str]:
     return [t + "\n" * (lines - 1 - t.count("\n")) for t in texts]
 
 
-def _scenes(geometry: _Geometry, frames: int) -> list[_Scene]:
+def _scenes(geometry: Geometry, frames: int) -> list[Scene]:
     """The scenes of every frame. Built without the trajectories (which every frame shares,
     added afterwards) so that each frame's search for its supports' places stays quick; the
     supports then stand where they cover least over the whole film."""
@@ -345,14 +343,14 @@ def _scenes(geometry: _Geometry, frames: int) -> list[_Scene]:
     return scenes
 
 
-def _still(sc: _Scene) -> _Scene:
+def _still(sc: Scene) -> Scene:
     """The parts of a scene that stay in every frame: the frame's points, supports and guides,
     and the trajectories."""
-    return _Scene(points={}, rails=sc.rails, pivots=sc.pivots, trajectories=sc.trajectories)
+    return Scene(points={}, rails=sc.rails, pivots=sc.pivots, trajectories=sc.trajectories)
 
 
-def _moving_part(sc: _Scene) -> _Scene:
-    return _Scene(points=sc.points, bodies=sc.bodies, slots=sc.slots, blocks=sc.blocks, pins=sc.pins, dots=sc.dots)
+def _moving_part(sc: Scene) -> Scene:
+    return Scene(points=sc.points, bodies=sc.bodies, slots=sc.slots, blocks=sc.blocks, pins=sc.pins, dots=sc.dots)
 
 
 def _check_dpi(dpi) -> None:
@@ -379,19 +377,19 @@ def _assembled_motion(mech: Mechanism, angles: np.ndarray) -> Motion:
     return motion
 
 
-def _steady_supports(scenes: list[_Scene], unit: float) -> None:
+def _steady_supports(scenes: list[Scene], unit: float) -> None:
     """Stand every frame pivot on the same support in every frame (a support chosen frame by
-    frame would jump): the first of :data:`~linkage.report.plots._SUPPORT_DIRECTIONS` (down
+    frame would jump): the first of :data:`~linkage.report.drawing.SUPPORT_DIRECTIONS` (down
     first) that covers at most :data:`SUPPORT_SLACK` times as many points of the links, guides,
     blocks and trajectories over the whole film as the direction that covers fewest. (A crank
     sweeps every direction alike; a support is moved off its usual place only for what stays in
     its way.) The trajectories, the same in every frame, count once."""
     if not scenes or not scenes[0].pivots:
         return
-    bare = [_Scene(points=sc.points, bodies=sc.bodies, slots=sc.slots, rails=sc.rails, blocks=sc.blocks)
+    bare = [Scene(points=sc.points, bodies=sc.bodies, slots=sc.slots, rails=sc.rails, blocks=sc.blocks)
             for sc in scenes]
-    samples = np.vstack([_samples(sc, unit) for sc in bare] + [_samples(_Scene(trajectories=scenes[0].trajectories),
-                                                                        unit)])
+    samples = np.vstack([scene_samples(sc, unit) for sc in bare]
+                        + [scene_samples(Scene(trajectories=scenes[0].trajectories), unit)])
     directions = [_support_direction(p, samples, unit) for p, _ in scenes[0].pivots]
     for sc in scenes:
         sc.pivots = [(p, d) for (p, _), d in zip(sc.pivots, directions)]
@@ -404,16 +402,16 @@ SUPPORT_SLACK = 1.25
 
 def _support_direction(p: np.ndarray, samples: np.ndarray, unit: float) -> float:
     """Direction (rad) of a frame pivot's support over a film (see :func:`_steady_supports`);
-    the support's region as :func:`~linkage.report.plots._pivot_direction` measures it."""
+    the support's region as :func:`~linkage.report.drawing._pivot_direction` measures it."""
     near = samples[(np.hypot(*(samples - p).T) > 0.5 * unit) & (np.hypot(*(samples - p).T) < 3.5 * unit)]
     covered = []
-    for deg in _SUPPORT_DIRECTIONS:
-        tri, ground, strokes = _support(p, math.radians(deg), unit)
-        region = _hull(np.vstack([tri, ground, strokes.reshape(-1, 2)]))
-        covered.append(int(np.sum(_inside(region, near))))
+    for deg in SUPPORT_DIRECTIONS:
+        tri, ground, strokes = support(p, math.radians(deg), unit)
+        region = convex_hull(np.vstack([tri, ground, strokes.reshape(-1, 2)]))
+        covered.append(int(np.sum(points_inside(region, near))))
     fewest = min(covered)
     first = next(k for k, c in enumerate(covered) if c <= SUPPORT_SLACK * fewest)
-    return math.radians(_SUPPORT_DIRECTIONS[first])
+    return math.radians(SUPPORT_DIRECTIONS[first])
 
 
 def write_animation(motion_or_mechanism: Motion | Mechanism, path, *, frames: int = 72, fps: float = 12,
@@ -467,7 +465,7 @@ def write_animation(motion_or_mechanism: Motion | Mechanism, path, *, frames: in
     ...     Image.open(gif).n_frames
     6
     """
-    _pyplot()
+    pyplot()
     if isinstance(fps, bool) or not isinstance(fps, (int, float, np.integer, np.floating)) \
             or not 0.5 <= float(fps) <= 50.0:
         raise InputError(f"fps must be a number from 0.5 to 50 frames per second, got {fps!r}")

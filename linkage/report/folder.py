@@ -29,10 +29,12 @@ from ..structure import structure_of
 from ..version import __version__
 from . import machine
 from .animation import write_animation
+from .diagrams import plot_columns, plot_dynamics, plot_motion
+from .drawing import draw_mechanism, draw_positions
 from .hodographs import plot_hodographs
-from .plots import draw_mechanism, draw_positions, link_role, plot_columns, plot_dynamics, plot_motion
 from .results import dynamics_results, forces_results, kinematics_results
 from .tables import format_columns, units_of
+from .words import link_role
 
 __all__ = ["ReportExtraMissing", "Report", "write_report", "REPORT_EXTRA"]
 

@@ -29,18 +29,10 @@ import numpy as np
 from ..errors import InputError
 from ..kinematics.motion import table_positions_deg
 from ..model.mechanism import Mechanism
-from .plots import (
-    CURVE_COLOURS,
-    FONT,
-    PAGE_WIDTH,
-    SMALL,
-    _Drawn,
-    _new_figure,
-    _place_labels,
-    _pyplot,
-    _Scene,
-    link_role,
-)
+from .drawing import Scene, place_point_labels
+from .labels import Drawn
+from .style import CURVE_COLOURS, FONT, PAGE_WIDTH, SMALL, new_figure, pyplot
+from .words import link_role
 
 __all__ = ["main_pairs", "pair_words", "plot_hodographs"]
 
@@ -191,14 +183,14 @@ def plot_hodographs(reactions, pairs: Sequence[str] | None = None, *, fine=None)
     >>> fig.savefig(io.BytesIO(), format="png")
     >>> matplotlib.pyplot.close(fig)
     """
-    _pyplot()
+    pyplot()
     names = _chosen_pairs(reactions, pairs)
     mech = reactions.motion.mechanism
     largest = max((float(np.nanmax(np.abs(reactions.force(n)), initial=0.0)) for n in reactions.multipliers),
                   default=0.0)
     ncols = 1 if len(names) == 1 else 2
     nrows = math.ceil(len(names) / ncols)
-    fig = _new_figure(PAGE_WIDTH, min(9.5, 0.75 + PANEL_HEIGHT * nrows))
+    fig = new_figure(PAGE_WIDTH, min(9.5, 0.75 + PANEL_HEIGHT * nrows))
     grid = fig.subplots(nrows, ncols, squeeze=False).ravel()
     numbers = np.arange(1, len(reactions.motion.phi) + 1)
     fig.suptitle(_header(reactions), fontsize=FONT)
@@ -336,15 +328,15 @@ def _thin_ticks(ax) -> None:
 
 def _number(ax, force: np.ndarray, numbers: np.ndarray) -> None:
     """Number the table positions along the hodograph, where the numbers cover no line, circle
-    or other number (:func:`~linkage.report.plots._place_labels`, outward from the curve)."""
+    or other number (:func:`~linkage.report.drawing.place_point_labels`, outward from the curve)."""
     ax.apply_aspect()
     x0, x1 = ax.get_xlim()
     y0, y1 = ax.get_ylim()
     span = max(x1 - x0, y1 - y0)
-    sc = _Scene(points=_numbers(force, numbers, span))
+    sc = Scene(points=_numbers(force, numbers, span))
     px_per_unit = abs(ax.transData.transform([[1.0, 0.0]])[0, 0] - ax.transData.transform([[0.0, 0.0]])[0, 0])
     radius = (_marker(len(force)) / 2 + 0.7) * ax.figure.dpi / 72.0 / px_per_unit
-    drawn = _Drawn()
+    drawn = Drawn()
     for line in ax.get_lines():
         data = np.asarray(line.get_xydata(), dtype=float)
         if (line.get_gid() or "").startswith("hodograph:"):
@@ -356,4 +348,4 @@ def _number(ax, force: np.ndarray, numbers: np.ndarray) -> None:
             drawn.polyline(seg, light=True)
     drawn.polyline(np.array([[x0, 0.0], [x1, 0.0]]), light=True)
     drawn.polyline(np.array([[0.0, y0], [0.0, y1]]), light=True)
-    _place_labels(ax, sc, list(sc.points), drawn, SMALL, radius)
+    place_point_labels(ax, sc, list(sc.points), drawn, SMALL, radius)

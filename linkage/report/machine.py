@@ -37,26 +37,18 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..dynamics.cycle import LawOfMotion, exact_method
+from ..dynamics.equation import simulate, steady_state
 from ..dynamics.motors import starting_moment
-from ..dynamics.pipeline import DynamicsReport, DynamicsSpec, LawOfMotion, exact_method, simulate, steady_state
+from ..dynamics.pipeline import DynamicsReport
 from ..dynamics.reduced import reduced_characteristics
+from ..dynamics.spec import DynamicsSpec
 from ..errors import InputError
 from ..kinematics.motion import table_positions_deg
 from ..model.mechanism import Mechanism
 from ..model.scheme import section_of
-from .plots import (
-    CURVE_COLOURS,
-    FONT,
-    MARKERS,
-    SMALL,
-    _figure_legend,
-    _finish_panels,
-    _new_figure,
-    _pyplot,
-    _wrapped,
-    extreme_marks,
-    plot_columns,
-)
+from .diagrams import extreme_marks, figure_legend, finish_panels, plot_columns, wrapped_label
+from .style import CURVE_COLOURS, FONT, MARKERS, SMALL, new_figure, pyplot
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -182,7 +174,7 @@ def plot_moments_and_work(report: DynamicsReport) -> Figure:
     PlotExtraMissing
         matplotlib is not installed.
     """
-    _pyplot()
+    pyplot()
     law = _course_law(report, "diagram of moments and work")
     mech, red, details = report.mechanism, law.reduced, law.details
     n = len(law.phi) - 1
@@ -191,23 +183,23 @@ def plot_moments_and_work(report: DynamicsReport) -> Figure:
     columns = {**report.columns(), "A_c": details["work_resistance"], "A_d": md * psi,
                "dT": details["energy_change"]}
     marks = _marks(mech, law.phi)
-    fig = _new_figure(FIGURE_WIDTH, 7.6)
+    fig = new_figure(FIGURE_WIDTH, 7.6)
     axes = fig.subplots(2, 1, sharex=True)
     driving = bool(np.any(red.moment_driving != 0))
     moments = ["reduced_moment_resistance"] + (["reduced_moment_driving"] if driving else [])
     plot_columns(columns, moments, axes[0], mechanism=mech, marks=marks, mean_moment=md,
                  mean_label=f"constant driving moment $M_d$ = {_signed(md)} N·m (balances the cycle)",
                  legend=False)
-    axes[0].set_ylabel(_wrapped("reduced moments $M_c$, $M_d$, N·m", axes[0]), fontsize=FONT)
+    axes[0].set_ylabel(wrapped_label("reduced moments $M_c$, $M_d$, N·m", axes[0]), fontsize=FONT)
     plot_columns(columns, ["A_c", "A_d", "dT"], axes[1], mechanism=mech, marks=marks, numbers=False,
                  legend=False)
     loads = "the declared loads" if driving else "the resistance and gravity"
     _relabel(axes[1], {"A_c": f"work of {loads} $A_c$ (J, trapezoid over the table positions)",
                        "A_d": r"work of the driving moment $A_d = M_d\,\psi$ (J)",
                        "dT": r"change of kinetic energy $\Delta T = A_d + A_c$ (J)"})
-    axes[1].set_ylabel(_wrapped(r"work $A_c$, $A_d$ and energy change $\Delta T$, J", axes[1]), fontsize=FONT)
-    _finish_panels(axes)
-    _figure_legend(fig, axes)
+    axes[1].set_ylabel(wrapped_label(r"work $A_c$, $A_d$ and energy change $\Delta T$, J", axes[1]), fontsize=FONT)
+    finish_panels(axes)
+    figure_legend(fig, axes)
     return fig
 
 
@@ -259,13 +251,13 @@ def plot_energy_inertia(report: DynamicsReport) -> Figure:
     PlotExtraMissing
         matplotlib is not installed.
     """
-    _pyplot()
+    pyplot()
     law = _course_law(report, "energy–inertia diagram")
     mech, red = report.mechanism, law.reduced
     x = np.asarray(red.inertia_variable, dtype=float)
     y = np.asarray(law.details["energy_change"], dtype=float)
     n = len(x) - 1
-    fig = _new_figure(FIGURE_WIDTH, 6.4)
+    fig = new_figure(FIGURE_WIDTH, 6.4)
     ax = fig.add_subplot()
     ax.plot(x, y, "-", color=CURVE_COLOURS[0], lw=1.6, marker=MARKERS[0], ms=5 if n <= 40 else 3.5, mfc="white",
             mew=1.3, zorder=3, label=r"$\Delta T$ against $I''$ at the table positions", gid="energy-inertia")
@@ -287,7 +279,7 @@ def plot_energy_inertia(report: DynamicsReport) -> Figure:
     ax.tick_params(labelsize=SMALL)
     ax.set_xlabel(f"variable part of the reduced moment of inertia $I''$, kg·m²  "
                   f"($I = I_0 + I''$, $I_0$ = {red.inertia_constant:.4g} kg·m²)", fontsize=FONT)
-    ax.set_ylabel(_wrapped(r"change of kinetic energy $\Delta T = A_d + A_c$, J", ax), fontsize=FONT)
+    ax.set_ylabel(wrapped_label(r"change of kinetic energy $\Delta T = A_d + A_c$, J", ax), fontsize=FONT)
     fig.legend(*ax.get_legend_handles_labels(), loc="outside lower center", fontsize=SMALL, frameon=False)
     return fig
 
@@ -353,17 +345,17 @@ def plot_flywheel_energy(report: DynamicsReport) -> Figure:
     PlotExtraMissing
         matplotlib is not installed.
     """
-    _pyplot()
+    pyplot()
     law = _course_law(report, "diagram of the flywheel energy")
     mech = report.mechanism
     omega_m, delta = _mean_speed_and_delta(law)
     energy = np.asarray(law.details["energy_flywheel"], dtype=float)
     columns = {**_table(law), "dT1": energy}
-    fig = _new_figure(FIGURE_WIDTH, 5.9)
+    fig = new_figure(FIGURE_WIDTH, 5.9)
     ax, text_ax = fig.subplots(2, 1, height_ratios=[4.8, 1])
     plot_columns(columns, ["dT1"], ax, mechanism=mech, marks=_marks(mech, law.phi), legend=False)
     _relabel(ax, {"dT1": r"energy change of the constant-inertia parts $\Delta T' = \Delta T - T''$ (J)"})
-    ax.set_ylabel(_wrapped(r"energy change $\Delta T' = \Delta T - T''$, J", ax), fontsize=FONT)
+    ax.set_ylabel(wrapped_label(r"energy change $\Delta T' = \Delta T - T''$, J", ax), fontsize=FONT)
     phi = columns["phi_deg"]
     high, low = int(np.argmax(energy)), int(np.argmin(energy))
     for k, which in ((high, "max"), (low, "min")):
@@ -407,7 +399,7 @@ def plot_speed_two_ways(report: DynamicsReport) -> Figure:
     Markers: the course method (Mertsalov) at the table positions. Fine curve: the periodic
     steady state of the equation of motion ``I(ψ)·ψ̈ + ½·(dI/dψ)·ψ̇² = M_d + M_red(ψ)`` with the
     same constant inertia (the law's ``constant_inertia``) and a constant driving moment ``M_d``
-    that balances the cycle on the equation's grid (:func:`~linkage.dynamics.pipeline.steady_state` with no
+    that balances the cycle on the equation's grid (:func:`~linkage.dynamics.equation.steady_state` with no
     motor; its ``M_d`` differs from the course method's where a load acts between table
     positions: both are written). The mean speed ``ω_m`` and the band ``ω_m·(1 ± δ/2)`` of the
     target δ are drawn on the speed panel; the δ of each solution is written in the legend.
@@ -434,7 +426,7 @@ def plot_speed_two_ways(report: DynamicsReport) -> Figure:
     PlotExtraMissing
         matplotlib is not installed.
     """
-    _pyplot()
+    pyplot()
     law = _course_law(report, "diagram of the speed")
     mech = report.mechanism
     omega_m, delta = _mean_speed_and_delta(law)
@@ -442,7 +434,7 @@ def plot_speed_two_ways(report: DynamicsReport) -> Figure:
     columns = {**_table(law), "omega": law.omega, "eps": law.eps}
     fine_deg = table_positions_deg(ode.phi)
     marks = _marks(mech, law.phi)
-    fig = _new_figure(FIGURE_WIDTH, 8.2)
+    fig = new_figure(FIGURE_WIDTH, 8.2)
     axes = fig.subplots(2, 1, sharex=True)
     sense = "clockwise: ω < 0" if omega_m < 0 else "counter-clockwise: ω > 0"
     ode_label = (f"equation of motion, periodic steady state (δ = {ode.delta_actual:.3g}): the same constant inertia "
@@ -460,8 +452,8 @@ def plot_speed_two_ways(report: DynamicsReport) -> Figure:
                            label=f"$\\omega_m\\,(1 \\pm \\delta/2)$, target δ = {delta:.4g}" if side > 0 else None)
         plot_columns(columns, [name], ax, mechanism=mech, marks=marks, numbers=k == 0, legend=False)
         _relabel(ax, {name: course_label}, {"color": CURVE_COLOURS[0], "ls": ":", "lw": 1.0})
-    _finish_panels(axes)
-    _figure_legend(fig, axes)
+    finish_panels(axes)
+    figure_legend(fig, axes)
     return fig
 
 
@@ -501,9 +493,9 @@ def plot_startup(mech: Mechanism, initial_speeds: Sequence[float] | None = None,
     """The start-up of the machine with its motor: ``|ω|`` against the crank angle travelled.
 
     One curve per initial speed, from the equation of motion with the scheme's motor
-    (:func:`~linkage.dynamics.pipeline.simulate`; a start from rest integrates its first degree in time),
+    (:func:`~linkage.dynamics.equation.simulate`; a start from rest integrates its first degree in time),
     and the mean speed of the periodic steady state with that motor
-    (:func:`~linkage.dynamics.pipeline.steady_state`) that every start-up approaches; the declared mean
+    (:func:`~linkage.dynamics.equation.steady_state`) that every start-up approaches; the declared mean
     speed is drawn for comparison.
 
     Parameters
@@ -538,7 +530,7 @@ def plot_startup(mech: Mechanism, initial_speeds: Sequence[float] | None = None,
     PlotExtraMissing
         matplotlib is not installed.
     """
-    _pyplot()
+    pyplot()
     spec = _declared(mech, "start-up diagram")
     if spec.motor is None:
         raise InputError(f"scheme '{mech.name}' declares no motor ([dynamics.motor]): with a constant driving moment "
@@ -551,7 +543,7 @@ def plot_startup(mech: Mechanism, initial_speeds: Sequence[float] | None = None,
         constant, origin = float(constant_inertia), "given"
     turns = cycles if cycles is not None else spec.cycles
     steady = abs(steady_state(mech, spec, constant_inertia=constant).details["mean_speed"])
-    fig = _new_figure(FIGURE_WIDTH, 5.6)
+    fig = new_figure(FIGURE_WIDTH, 5.6)
     ax = fig.add_subplot()
     for k, w0 in enumerate(speeds):
         run = simulate(mech, spec, initial_speed=w0, cycles=turns, constant_inertia=constant)
@@ -565,7 +557,7 @@ def plot_startup(mech: Mechanism, initial_speeds: Sequence[float] | None = None,
     _style_turns(ax, turns)
     ax.set_ylim(bottom=0.0)
     ax.set_xlabel("crank angle travelled from position 1, turns (360° each)", fontsize=FONT)
-    ax.set_ylabel(_wrapped("angular speed of the crank $|\\omega|$ (magnitude), rad/s", ax), fontsize=FONT)
+    ax.set_ylabel(wrapped_label("angular speed of the crank $|\\omega|$ (magnitude), rad/s", ax), fontsize=FONT)
     ax.set_title(f"start-up of '{mech.name}' with its motor; constant inertia at the crank {constant:.4g} kg·m² "
                  f"({origin})" + "".join(f"; {note}" for note in notes), fontsize=SMALL, loc="left", wrap=True)
     fig.legend(*ax.get_legend_handles_labels(), loc="outside lower center", fontsize=SMALL, frameon=False)

@@ -38,7 +38,10 @@ import numpy as np
 
 from ..errors import InputError
 from ..kinetostatics.plans import POLE, ForcePolygon, Plans
-from .plots import FONT, LINK_COLOURS, SMALL, _caption, _clip_lengths, _hull, _pyplot, _sub, draw_mechanism
+from .drawing import convex_hull, draw_mechanism
+from .labels import Drawn, Label, place_labels
+from .style import FONT, LINK_COLOURS, SMALL, pyplot
+from .words import position_caption, subscript
 
 __all__ = ["TARGET_MM", "nice_scale", "drawing_scales", "draw_plan", "draw_force_polygons", "draw_lever", "draw_sheet",
            "write_plan_drawings"]
@@ -151,12 +154,12 @@ def _force_name(label: str) -> str:
     m = re.fullmatch(r"([RM])\[(.+),(.+)\](?:\((.+)\))?", label)
     if m:
         head, i, j, pair = m.groups()
-        sub = _sub(i) + _sub(j) if len(i) == len(j) == 1 else _sub(f"{i},{j}")
+        sub = subscript(i) + subscript(j) if len(i) == len(j) == 1 else subscript(f"{i},{j}")
         return f"${head}_{{{sub}}}$" + (f" ({pair})" if pair else "")
     m = re.fullmatch(r"(G|Fi|Mi|Mb)(.+)", label)
     if m:                                               # of a link: G2, Fi2, Mi2, Mb4
         head, link = m.groups()
-        return f"${head[0]}_{{{head[1:]}{_sub(link)}}}$"
+        return f"${head[0]}_{{{head[1:]}{subscript(link)}}}$"
     m = re.fullmatch(r"([FM])(.+)", label)
     if m:                                               # a force at a point (FB), a moment on a link (M3)
         return f"${m.group(1)}_{{{_math(m.group(2))}}}$"
@@ -228,7 +231,9 @@ def _draw(ax, sketch: _Sketch, limits: tuple[float, float, float, float]) -> Non
 
 def _place_labels(ax, sketch: _Sketch) -> None:
     """Point labels around their dots, vector labels beside their arrows: each the candidate of
-    least cost (on another label, on an arrow or a dot, outside the axes, far from its place)."""
+    least cost (on another label, on an arrow or a dot, outside the axes, far from its place), in
+    mm of the drawing (:func:`~linkage.report.labels.place_labels`). A vector's label with no free
+    place is left out (the table names the vector); a point's label far from its dot gets a leader."""
     fig = ax.figure
     ax.apply_aspect()
     renderer = fig.canvas.get_renderer()
@@ -239,62 +244,45 @@ def _place_labels(ax, sketch: _Sketch) -> None:
     drawn = [a for a in sketch.arrows if np.hypot(*(a.end - a.start)) >= SHORTEST_MM]
     segments = np.array([[*a.start, *a.end] for a in drawn] + [[*ln[k], *ln[k + 1]] for ln, _ in sketch.lines
                                                              for k in range(len(ln) - 1)], dtype=float).reshape(-1, 4)
-    segments = segments[np.all(np.isfinite(segments), axis=1)]
-    dots = np.array([d[0] for d in sketch.dots], dtype=float).reshape(-1, 2)
-    placed = np.zeros((0, 4))
-    items = [(label, xy, None) for xy, label, _ in sketch.dots if label]
-    labelled = sorted((a for a in drawn if a.label and np.hypot(*(a.end - a.start)) >= LABELLED_MM),
-                      key=lambda a: np.hypot(*(a.end - a.start)))     # the shortest, least free, first
-    items += [(a.label, None, a) for a in labelled]
-    for text, xy, arrow in items:
-        artist = ax.text(0, 0, text, fontsize=SMALL if arrow is not None else FONT, ha="center", va="center",
-                         zorder=8, color=arrow.colour if arrow is not None else "black",
-                         bbox=dict(boxstyle="square,pad=0.05", fc="white", ec="none", alpha=0.8))
-        bb = artist.get_window_extent(renderer)
-        w, h = (bb.width + 2) * mm_per_px, (bb.height + 1) * mm_per_px
-        if arrow is None:
-            angles = np.radians(np.arange(0, 360, 22.5) + 45)
-            rings = np.array(RINGS_MM)
-            a = np.tile(angles, len(rings))
-            r = np.repeat(rings, len(angles))
-            d = np.stack([np.cos(a), np.sin(a)], axis=1)
-            centre = xy + (r + np.abs(d[:, 0]) * w / 2 + np.abs(d[:, 1]) * h / 2)[:, None] * d
-            preference = 4.0 * np.repeat(np.arange(len(rings)), len(angles))
-        else:
-            u = arrow.end - arrow.start
-            length = np.hypot(*u)
-            u = u / length
-            n = np.array([-u[1], u[0]])
-            along = np.array([0.5, 0.38, 0.62, 0.25, 0.75])
-            side = np.array([1.0, -1.0])
-            gap = np.array([0.8, 2.2, 4.0, 6.5])
-            t, s, g = (x.ravel() for x in np.meshgrid(along, side, gap, indexing="ij"))
-            half = np.abs(n[0]) * w / 2 + np.abs(n[1]) * h / 2
-            centre = arrow.start + (t * length)[:, None] * u + ((g + half) * s)[:, None] * n
-            preference = 6.0 * np.abs(t - 0.5) + 2.0 * g
-        boxes = np.column_stack([centre[:, 0] - w / 2, centre[:, 1] - h / 2, centre[:, 0] + w / 2,
-                                 centre[:, 1] + h / 2])
-        cost = preference.astype(float)
-        outside = (np.maximum(0, x0 - boxes[:, 0]) + np.maximum(0, boxes[:, 2] - x1)
-                   + np.maximum(0, y0 - boxes[:, 1]) + np.maximum(0, boxes[:, 3] - y1))
-        cost += 1e5 * outside
-        for q in placed:
-            ow = np.minimum(boxes[:, 2], q[2]) - np.maximum(boxes[:, 0], q[0])
-            oh = np.minimum(boxes[:, 3], q[3]) - np.maximum(boxes[:, 1], q[1])
-            cost += np.where((ow > -0.3) & (oh > -0.3), 1e4 + 100 * np.maximum(ow, 0) * np.maximum(oh, 0), 0.0)
-        cost += 80.0 * _clip_lengths(segments, boxes)
-        for p in dots:
-            nx = np.clip(p[0], boxes[:, 0], boxes[:, 2])
-            ny = np.clip(p[1], boxes[:, 1], boxes[:, 3])
-            cost += np.where(np.hypot(nx - p[0], ny - p[1]) < 1.2, 3e3, 0.0)
-        k = int(np.argmin(cost))
-        if arrow is not None and cost[k] >= DROP_COST:   # no free place: the table names the vector
-            artist.remove()
+    obstacles = Drawn()
+    obstacles.segments = [segments[np.all(np.isfinite(segments), axis=1)]]
+    obstacles.discs = [(p, 1.2) for p in np.array([d[0] for d in sketch.dots], dtype=float).reshape(-1, 2)]
+    angles = np.radians(np.arange(0, 360, 22.5) + 45)
+    rings = np.array(RINGS_MM)
+    a = np.tile(angles, len(rings))
+    around = np.stack([np.cos(a), np.sin(a)], axis=1)
+    labels, anchors = [], []
+    for xy, label, _ in sketch.dots:
+        if label:
+            text = ax.text(0, 0, label, fontsize=FONT, ha="center", va="center", zorder=8, color="black",
+                           bbox=dict(boxstyle="square,pad=0.05", fc="white", ec="none", alpha=0.8))
+            labels.append(Label(text, xy, around, np.repeat(rings, len(angles)),
+                                4.0 * np.repeat(np.arange(len(rings)), len(angles))))
+            anchors.append(xy)
+    for arrow in sorted((a for a in drawn if a.label and np.hypot(*(a.end - a.start)) >= LABELLED_MM),
+                        key=lambda a: np.hypot(*(a.end - a.start))):     # the shortest, least free, first
+        text = ax.text(0, 0, arrow.label, fontsize=SMALL, ha="center", va="center", zorder=8, color=arrow.colour,
+                       bbox=dict(boxstyle="square,pad=0.05", fc="white", ec="none", alpha=0.8))
+        u = arrow.end - arrow.start
+        length = np.hypot(*u)
+        u = u / length
+        n = np.array([-u[1], u[0]])
+        along = np.array([0.5, 0.38, 0.62, 0.25, 0.75])
+        side = np.array([1.0, -1.0])
+        gap = np.array([0.8, 2.2, 4.0, 6.5])
+        t, s, g = (x.ravel() for x in np.meshgrid(along, side, gap, indexing="ij"))
+        labels.append(Label(text, arrow.start + (t * length)[:, None] * u, s[:, None] * n, g,
+                            6.0 * np.abs(t - 0.5) + 2.0 * g, drop=DROP_COST))   # no free place: the table names it
+        anchors.append(None)
+    places = place_labels(labels, obstacles, (x0, y0, x1, y1), renderer, per_px=mm_per_px, line_cost=80.0,
+                          clearance=0.3)
+    for label, xy, place in zip(labels, anchors, places):
+        if place is None:
             continue
-        placed = np.vstack([placed, boxes[k]])
-        artist.set_position(tuple(centre[k]))
-        if arrow is None and np.hypot(*(centre[k] - xy)) > LEADER_MM:      # far from its dot: a leader
-            edge = centre[k] - np.clip(centre[k] - xy, -np.array([w, h]) / 2, np.array([w, h]) / 2)
+        label.text.set_position(tuple(place.centre))
+        if xy is not None and np.hypot(*(place.centre - xy)) > LEADER_MM:      # far from its dot: a leader
+            size = np.array([place.width, place.height])
+            edge = place.centre - np.clip(place.centre - xy, -size / 2, size / 2)
             ax.plot([xy[0], edge[0]], [xy[1], edge[1]], color="0.45", lw=0.5, zorder=7)
 
 
@@ -314,7 +302,7 @@ def _figure(sk: _Sketch, pts: list[np.ndarray], colour: str, closed_only: bool =
     pts = pts[np.all(np.isfinite(pts), axis=1)]
     if len(pts) < 2:
         return
-    hull = _hull(pts)
+    hull = convex_hull(pts)
     if len(hull) >= 3:
         sk.lines.append((np.vstack([hull, hull[:1]]), colour))
     elif len(hull) == 2 and not closed_only:
@@ -386,7 +374,7 @@ def _plan_table(plans: Plans, i: int, quantity: str, scale: float) -> list[tuple
     motion_of = plans.angular_velocity if quantity == "velocity" else plans.angular_acceleration
     sym, u = (r"\omega", "rad/s") if quantity == "velocity" else (r"\varepsilon", "rad/s²")
     for k, w in motion_of.items():
-        rows.append((f"${sym}_{_sub(k)}$", "", f"{_number(float(w[i]))} {u}"))
+        rows.append((f"${sym}_{subscript(k)}$", "", f"{_number(float(w[i]))} {u}"))
     return rows
 
 
@@ -477,7 +465,7 @@ def _lever_sketch(plans: Plans, i: int, scale: float, force_scale: float) -> _Sk
         rows.append((f"{_force_name(f.label)} at {_image_name(f.point, 'p')}", f"h = {arm:.1f} mm",
                      f"{moment(float(f.moment[i]))} N·m/s"))
     for m in lever.moments:
-        rows.append((f"{_force_name(m.label)}·$\\omega_{_sub(m.link)}$",
+        rows.append((f"{_force_name(m.label)}·$\\omega_{subscript(m.link)}$",
                      f"{_number(float(m.value[i]))} · {_factor(float(m.angular_velocity[i]))}",
                      f"{moment(float(m.contribution[i]))} N·m/s"))
     omega = float(lever.omega[i])
@@ -543,7 +531,7 @@ COLUMN_LINES = 16
 def _true_scale_figure(sketches: Sequence[_Sketch], header: Sequence[str]):
     """A figure holding the sketches side by side at true size (1 mm of data = 1 mm of paper),
     each with its title above and its table below; ``header`` lines on top."""
-    plt = _pyplot()
+    plt = pyplot()
     pad = 8.0
     sizes = [_sketch_size(sk) for sk in sketches]
     columns = [math.ceil(len(sk.table) / COLUMN_LINES) for sk in sketches]
@@ -593,7 +581,7 @@ def _true_scale_figure(sketches: Sequence[_Sketch], header: Sequence[str]):
 def _header(plans: Plans, i: int) -> list[str]:
     motion = plans.motion
     mech = motion.mechanism
-    caption = _caption(motion, i).replace("\n", " ")
+    caption = position_caption(motion, i).replace("\n", " ")
     omega, eps = float(motion.omega[i]), float(motion.eps[i])
     return [f"{mech.name}: {caption}",
             f"ω₁ = {_number(omega)} rad/s, ε₁ = {_number(eps)} rad/s²"]
@@ -689,7 +677,7 @@ def draw_sheet(plans: Plans, position: int):
     mechanism to scale, the plans of velocities and accelerations, the force polygons and
     Zhukovsky's lever, each at a scale chosen to fill its cell and written on it."""
 
-    plt = _pyplot()
+    plt = pyplot()
     i = _check(plans, position)
     motion = plans.motion
     colour = _colours(motion.mechanism)
@@ -769,7 +757,7 @@ def write_plan_drawings(plans: Plans, position: int, folder: str | Path, *, form
     ``formats`` (``svg``, ``png``). ``scales``: ``velocity`` ((m/s)/mm), ``acceleration``
     ((m/s²)/mm), ``force`` (N/mm, every polygon), any of them (default: chosen); ``dpi``: of the
     PNG files; ``drawings``: which of :data:`DRAWINGS` to write. Returns the paths written."""
-    plt = _pyplot()
+    plt = pyplot()
     formats = list(formats)
     bad = [f for f in formats if f not in ("svg", "png")]
     if bad:

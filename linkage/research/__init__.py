@@ -1,6 +1,33 @@
 """Research: many mechanisms from one, measured side by side.
 
-The enumeration of pair kinds over a scheme's chain (:mod:`~.enumeration`): every R/P
-assignment that decomposes into solvable groups, its geometry placed, checked over a full turn
-and measured. Reads every analysis stage and the report's tables.
+The enumeration of pair kinds over a scheme's chain: every R/P assignment of its pairs and the
+source's reference positions (:mod:`~.assignments`); each assignment's mechanism with the
+source's geometry, and whether it decomposes into solvable groups (:mod:`~.geometry`); for a
+group solved by Newton's method, the assembly mode of the reference position, followed over a
+turn and declared by a readable condition (:mod:`~.placement`); every solvable assignment checked
+over a full turn and measured, the table and the schemes written (:mod:`~.enumeration`). Reads
+every analysis stage and the report's tables. The public API is exported here.
 """
+
+from .assignments import Assignment, PairKind, Reference, assignments, reference_positions
+from .enumeration import (COLUMN_UNITS, CRANK_FACTORS, DEFAULT_OMEGA, Combination, Enumeration, Rejected,
+                          enumerate_chain, measure)
+from .placement import MIN_CONDITIONING, build_combination
+
+__all__ = [
+    "COLUMN_UNITS",
+    "CRANK_FACTORS",
+    "DEFAULT_OMEGA",
+    "MIN_CONDITIONING",
+    "Assignment",
+    "Combination",
+    "Enumeration",
+    "PairKind",
+    "Reference",
+    "Rejected",
+    "assignments",
+    "build_combination",
+    "enumerate_chain",
+    "measure",
+    "reference_positions",
+]
