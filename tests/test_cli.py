@@ -458,6 +458,18 @@ def test_an_input_law_too_fast_to_resolve_is_the_users_error(capsys):
     assert "extreme positions cannot be found" in err and "different signs" not in err
 
 
+def test_a_folder_that_cannot_be_made_is_the_users_error(capsys, tmp_path):
+    """``--out`` under a regular file: the folder cannot be made (an OSError the user caused),
+    said in one line naming the path, with the input-error status, not as an internal error."""
+    blocker = tmp_path / "a_file"
+    blocker.write_text("")
+    target = blocker / "drawings"
+    code, out, err = run(capsys, "plans", "slider_crank", "--position", "3", "--omega", "-10",
+                         "--format", "svg", "--out", str(target))
+    assert code == 2 and "internal error" not in err and "Traceback" not in err
+    assert str(blocker) in err.splitlines()[-1]
+
+
 LONG_CRANK = """
 name = "long_crank"
 input = "1"

@@ -1,8 +1,5 @@
 """The runnable examples run, and the plots draw what the analysis computed."""
 
-import os
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -25,22 +22,18 @@ def test_there_are_examples():
 
 
 @pytest.mark.parametrize("script", EXAMPLES, ids=lambda p: p.stem)
-def test_example_runs_and_writes_its_pictures(script, tmp_path):
-    env = dict(os.environ, MPLBACKEND="Agg", PYTHONPATH=str(ROOT))
-    done = subprocess.run([sys.executable, str(script), str(tmp_path)], cwd=ROOT, env=env,
-                          capture_output=True, text=True, timeout=120)
-    assert done.returncode == 0, done.stderr
-    assert "Traceback" not in done.stderr
-    assert list(tmp_path.rglob("*.png")), done.stdout
+def test_example_runs_and_writes_its_pictures(script, example_run):
+    done = example_run(script)
+    assert done.status == 0, done.err
+    assert "Traceback" not in done.err
+    assert list(done.cwd.rglob("*.png")), done.out
 
 
-def test_custom_mechanism_example_reports_the_lever_stroke(tmp_path):
+def test_custom_mechanism_example_reports_the_lever_stroke(example_run):
     """The lever press: a crank of 0.06 m at 0.15 m from the lever pivot swings the 0.4 m lever by
     +-asin(0.06/0.15); the rod keeps the slider on the rail y = 0.45, so the stroke of F is the
     difference of x_F = x_D + sqrt(0.2^2 - (0.45 - y_D)^2) at the two lever extremes."""
-    env = dict(os.environ, MPLBACKEND="Agg", PYTHONPATH=str(ROOT))
-    out = subprocess.run([sys.executable, str(ROOT / "examples" / "custom_mechanism.py"), str(tmp_path)],
-                         cwd=ROOT, env=env, capture_output=True, text=True, timeout=120).stdout
+    out = example_run(ROOT / "examples" / "custom_mechanism.py").out
     swing = np.arcsin(0.06 / 0.15)
     x_f = [0.4 * np.sin(s) + np.sqrt(0.2**2 - (0.45 - 0.4 * np.cos(s)) ** 2) for s in (swing, -swing)]
     stroke_mm = (x_f[0] - x_f[1]) * 1000

@@ -300,15 +300,12 @@ def _readme_linkage_commands() -> list[str]:
 
 
 @pytest.mark.parametrize("command", _readme_linkage_commands())
-def test_readme_command_lines_run(command, tmp_path, monkeypatch):
-    from linkage.cli import main
-
-    monkeypatch.chdir(tmp_path)
-    out, err = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-        status = main(shlex.split(command)[1:])
-    assert status == 0, f"{command} -> exit {status}\n{err.getvalue()[-2000:]}"
-    assert out.getvalue().strip(), f"{command} printed nothing"
+def test_readme_command_lines_run(command, linkage_run):
+    """Each command as written, in a folder of its own (tests that check its output more closely
+    share the same run: ``linkage_run`` in tests/conftest.py)."""
+    done = linkage_run(*shlex.split(command)[1:])
+    assert done.status == 0, f"{command} -> exit {done.status}\n{done.err[-2000:]}"
+    assert done.out.strip(), f"{command} printed nothing"
 
 
 @pytest.mark.parametrize("doc", DOCS, ids=_rel)

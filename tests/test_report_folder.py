@@ -32,23 +32,22 @@ class _References(html.parser.HTMLParser):
         self.targets += [value for name, value in attrs if name in ("src", "href") and value]
 
 
-def _report(tmp_path_factory, scheme: str):
-    out = tmp_path_factory.mktemp(scheme)
-    from linkage.cli import main
-
-    status = main(["report", scheme, "--out", str(out)])
-    assert status == 0
-    return out
-
-
-@pytest.fixture(scope="module")
-def press(tmp_path_factory):
-    return _report(tmp_path_factory, "course_slider_crank")
+def _report(linkage_run, scheme: str):
+    """The report folder of ``linkage report SCHEME --out report`` (the README's command for the
+    press: one run shared with tests/test_readme.py)."""
+    done = linkage_run("report", scheme, "--out", "report")
+    assert done.status == 0, done.err
+    return done.cwd / "report"
 
 
 @pytest.fixture(scope="module")
-def four_bar(tmp_path_factory):
-    return _report(tmp_path_factory, "four_bar")
+def press(linkage_run):
+    return _report(linkage_run, "course_slider_crank")
+
+
+@pytest.fixture(scope="module")
+def four_bar(linkage_run):
+    return _report(linkage_run, "four_bar")
 
 
 def test_the_press_report_holds_every_table_picture_and_the_film(press):

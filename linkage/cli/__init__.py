@@ -18,7 +18,7 @@ Every scheme argument takes ``--input-law LINK:LAW`` for the further inputs of a
 several (docs/inputs.md).
 
 The package holds one module per command (:mod:`.schemes`, :mod:`.analyze`, :mod:`.forces`,
-:mod:`.dynamics`, :mod:`.report`, :mod:`.variants`, :mod:`.enumerate`, :mod:`.plans`), each with
+:mod:`.dynamics`, :mod:`.report`, :mod:`.variants`, :mod:`.enumeration`, :mod:`.plans`), each with
 an ``add(subparsers)`` function that registers its parser and sets ``handler`` to its
 ``run(args) -> int``, and :mod:`.options` with what the commands share: the argument types and
 the functions that add the common arguments, the help formatter, the table conventions and the
@@ -31,7 +31,8 @@ for people a default selection at most :data:`~linkage.cli.options.TABLE_WIDTH` 
 positions, start, speed and loads declared in it. Notes, warnings and errors go to stderr, each
 note once per run. Errors of the input (:class:`linkage.LinkageError`, the family of every error
 the library raises on purpose, and argparse's) print one line per problem and exit with status
-:data:`EXIT_INPUT` (2), without a traceback; warnings are printed as ``linkage: warning: ...``
+:data:`EXIT_INPUT` (2), without a traceback, as does a file or folder that cannot be read or
+written (``OSError``); warnings are printed as ``linkage: warning: ...``
 lines (never as Python's warning text); any other exception (a bug, a bare ``ValueError`` of
 numpy included) prints one ``internal error`` line and exits with status :data:`EXIT_INTERNAL` (1).
 """
@@ -47,7 +48,7 @@ from typing import Callable, Sequence
 from ..errors import LinkageError
 from ..report.results import NUMERICAL_WARNING
 from ..version import __version__
-from . import analyze, dynamics, enumerate, forces, plans, report, schemes, variants
+from . import analyze, dynamics, enumeration, forces, plans, report, schemes, variants
 from .options import CONVENTIONS, EXIT_INPUT, EXIT_INTERNAL, PROG, SAID, HelpFormatter, error_lines, note
 
 __all__ = ["main", "build_parser", "COMMANDS", "EXIT_INPUT", "EXIT_INTERNAL"]
@@ -55,7 +56,7 @@ __all__ = ["main", "build_parser", "COMMANDS", "EXIT_INPUT", "EXIT_INTERNAL"]
 
 #: functions that register one subcommand each, in the order ``--help`` lists them
 COMMANDS: list[Callable] = [schemes.add, analyze.add, forces.add, dynamics.add, report.add, variants.add,
-                            enumerate.add, plans.add]
+                            enumeration.add, plans.add]
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -93,6 +94,10 @@ def main(argv: Sequence[str] | None = None) -> int:
             except (OSError, ValueError, AttributeError):
                 pass
             return 0
+        except OSError as exc:  # a file or folder the user named cannot be read or written
+            where = f"{exc.filename}: " if exc.filename else ""
+            note("error", f"{where}cannot be read or written ({exc.strerror or exc})")
+            return EXIT_INPUT
         except Exception as exc:  # a bug of the library: one line, no traceback
             note("error", f"internal error ({type(exc).__name__}: {exc}); please report it with the "
                           "command line that caused it")

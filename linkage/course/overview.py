@@ -20,8 +20,23 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InputError
-from .typesetting import (A4, BOTTOM, HEADING, SIDE, TEXT, TOP, Measure, footer, line_height, new_page, page_style,
-                          pdf_bytes, rule, shade, write)
+from .typesetting import (
+    A4,
+    BOTTOM,
+    HEADING,
+    SIDE,
+    TEXT,
+    TOP,
+    Measure,
+    footer,
+    line_height,
+    new_page,
+    page_style,
+    pdf_bytes,
+    rule,
+    shade,
+    write,
+)
 
 __all__ = ["ROWS_PER_PAGE", "overview_figures", "overview_pdf"]
 

@@ -41,8 +41,29 @@ from ..model.mechanism import Mechanism, Prismatic
 from ..model.scheme import section_of
 from ..report.drawing import Geometry, draw_mechanism, rail_hatch, support
 from ..report.results import declared_rotation, table_defaults, table_positions
-from .typesetting import (A4, BOTTOM, FOOT, HEADING, MM, SIDE, TABLE, TEXT, TITLE, TOP, Block, Measure, flow, footer,
-                          line_height, new_page, page_style, pdf_bytes, rule, shade, write)
+from .typesetting import (
+    A4,
+    BOTTOM,
+    FOOT,
+    HEADING,
+    MM,
+    SIDE,
+    TABLE,
+    TEXT,
+    TITLE,
+    TOP,
+    Block,
+    Measure,
+    flow,
+    footer,
+    line_height,
+    new_page,
+    page_style,
+    pdf_bytes,
+    rule,
+    shade,
+    write,
+)
 
 __all__ = ["assignment_sheet", "sheet_figures", "standard_scale", "scale_text", "table_motion"]
 

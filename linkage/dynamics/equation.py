@@ -46,6 +46,9 @@ from .spec import (
 
 __all__ = ["REST_START_ANGLE", "Transient", "simulate", "steady_state"]
 
+#: ``scipy.integrate.solve_ivp``'s status when an integration step failed
+IVP_FAILED = -1
+
 
 @dataclass(frozen=True)
 class Transient:
@@ -165,7 +168,7 @@ def _integrate(eq: _Equation, energy0: float, cycles: float, rtol: float, atol: 
 
 
 def _raise_events(sol, eq: _Equation, what: str) -> None:
-    if sol.status == -1:
+    if sol.status == IVP_FAILED:
         raise DynamicsError(f"{what}: the integration failed ({sol.message})")
     if len(sol.t_events[0]):
         psi = sol.t_events[0][0]
@@ -317,7 +320,7 @@ def _from_rest(eq: _Equation, spec: DynamicsSpec, cycles: int, rtol: float, atol
     first = solve_ivp(rhs, (0.0, 1e6 * t_scale), [0.0, 0.0], method="RK45", rtol=rtol,
                       atol=[1e-3 * rtol * REST_START_ANGLE, 1e-3 * rtol * w_scale], dense_output=True,
                       events=[switch, stall, runaway], max_step=t_scale / 10)
-    if first.status == -1:
+    if first.status == IVP_FAILED:
         raise DynamicsError(f"{name}: the integration from rest failed ({first.message})")
     if len(first.t_events[1]):
         raise DynamicsError(f"{name}: the machine stalls (omega -> 0) after {first.t_events[1][0]:.3g} s, within "

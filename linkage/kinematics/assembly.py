@@ -26,7 +26,7 @@ from typing import NamedTuple
 import numpy as np
 from scipy.optimize import minimize_scalar
 
-from assur.base import OK, SINGULAR, Group, GroupSolution, global_point
+from assur.base import CANNOT_ASSEMBLE, OK, SINGULAR, Group, GroupSolution, global_point
 from assur.generic import TRACE_JUMP, newton
 
 from ..errors import SchemeError
@@ -210,7 +210,7 @@ def assembly_plans(mech: Mechanism) -> tuple[BranchPlan, ...]:
         mode = rule.mode if rule is not None else "keep"
         # the first branch's placement: both branches of a closed form assemble at the same angles
         first = group.position(poses, group.branches[0])
-        if np.all(first.status == -1):
+        if np.all(first.status == CANNOT_ASSEMBLE):
             _never_assembles(mech, group, poses)
         if len(group.branches) == 1:
             plan = BranchPlan(1, "keep", np.empty(0), np.empty(0, bool), period=mech.coordinate.period)
@@ -764,7 +764,7 @@ def _swaps(mech, structure, plans, i, angle) -> bool | None:
     features = {}
     for m in group.branches:
         placed = group.position(poses, m)
-        if np.any(placed.status == -1):
+        if np.any(placed.status == CANNOT_ASSEMBLE):
             return None
         merged = {**poses, **placed.poses}
         contacts = group.contact_points(merged)                      # (6, J, 2)

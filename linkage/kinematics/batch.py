@@ -29,7 +29,7 @@ from ..errors import AssemblyError, InputError
 from ..model.mechanism import Mechanism
 from ..structure import Structure, structure_of
 from .assembly import assembly_plans
-from .motion import JUMP_CHECK_STEP, BranchWarning, Motion, _links_of, _run_blocks, jump_steps
+from .motion import JUMP_CHECK_STEP, BranchWarning, Motion, jump_steps, links_needed, run_blocks
 
 __all__ = ["OTHER_BRANCH", "VariantMotion", "analyze_variants", "geometry_of"]
 
@@ -119,7 +119,7 @@ class VariantMotion:
         link = self.mechanism.point_link(name)
         if link not in self.poses:
             raise InputError(f"point '{name}' (link '{link}') was not among the requested outputs")
-        return link, _per_position(self.geometry[link][name], len(self.phi))
+        return link, repeat_per_angle(self.geometry[link][name], len(self.phi))
 
 
 def geometry_of(mechanisms: Sequence[Mechanism]) -> dict[str, dict[str, np.ndarray]]:
@@ -203,7 +203,7 @@ def analyze_variants(
     count = len(next(iter(next(iter(local.values())).values())))
     n = len(phi)
     plans = assembly_plans(mech)
-    group_ids = list(range(len(base.groups))) if outputs is None else base.needed_groups(_links_of(mech, outputs))
+    group_ids = list(range(len(base.groups))) if outputs is None else base.needed_groups(links_needed(mech, outputs))
     for i in group_ids:
         if plans[i].mode == "follow" and plans[i].swaps.any():
             raise InputError(f"mechanism '{mech.name}': group {base.groups[i]!r} follows its motion through change "
@@ -212,7 +212,7 @@ def analyze_variants(
     size = np.repeat(_sizes(mech, local), n)
     batch = _BatchStructure(mech, base, local, n, size)
     structure = batch.whole
-    run = _run_blocks(mech, structure, plans, group_ids, np.tile(phi, count), order, batch.at)
+    run = run_blocks(mech, structure, plans, group_ids, np.tile(phi, count), order, batch.at)
     status = run.status.reshape(count, n)
     mode_change = np.zeros(count, bool)
     for i in group_ids:
@@ -298,7 +298,7 @@ def _sizes(mech: Mechanism, local: dict) -> np.ndarray:
     return np.where(size > 0, size, 1.0)
 
 
-def _per_position(values: np.ndarray, n: int) -> np.ndarray:
+def repeat_per_angle(values: np.ndarray, n: int) -> np.ndarray:
     """``(V, 2)`` per-variant coordinates repeated for n angles: ``(V n, 2)``, each coordinate
     contiguous (the solvers read them as two ``(V n,)`` columns)."""
     return np.asfortranarray(np.repeat(values, n, axis=0))
@@ -317,9 +317,9 @@ class _BatchStructure:
     @staticmethod
     def _joint(joint, local: dict, n: int, point: str):
         if isinstance(joint, RevoluteJoint):
-            return replace(joint, pa=_per_position(local[joint.a][point], n),
-                           pb=_per_position(local[joint.b][point], n))
-        return replace(joint, p=_per_position(local[joint.b][point], n))
+            return replace(joint, pa=repeat_per_angle(local[joint.a][point], n),
+                           pb=repeat_per_angle(local[joint.b][point], n))
+        return replace(joint, p=repeat_per_angle(local[joint.b][point], n))
 
     def at(self, rows: slice):
         joints = {}

@@ -24,7 +24,11 @@ from ..errors import InputError
 from ..model.mechanism import Mechanism
 from .motion import analyze
 
-__all__ = ["Extremes", "extreme_positions", "table_angles", "wrap_angle"]
+__all__ = ["Extremes", "NO_STROKE", "extreme_positions", "table_angles", "wrap_angle"]
+
+#: A stroke at most this (rad for an angle; times the mechanism's size for a coordinate in m) is
+#: none: the quantity does not move (:meth:`Extremes.moves`)
+NO_STROKE = 1e-9
 
 
 @dataclass(frozen=True)
@@ -54,6 +58,12 @@ class Extremes:
     def stroke(self) -> float:
         """``value_max - value_min``."""
         return self.value_max - self.value_min
+
+    def moves(self, size: float) -> bool:
+        """Whether the quantity has a stroke: more than :data:`NO_STROKE` rad for an angle
+        (``*.theta``), more than ``NO_STROKE * size`` for a coordinate in m (``size``: the
+        mechanism's, m)."""
+        return self.stroke > NO_STROKE * (1.0 if self.quantity.endswith(".theta") else size)
 
 
 def wrap_angle(angle):

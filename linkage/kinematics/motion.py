@@ -33,6 +33,7 @@ from assur.base import (
 from assur.rows import frame, xy
 
 from ..errors import AssemblyError, ConvergenceError, InputError
+from ..model.input_laws import ANGLE_TOL
 from ..model.mechanism import Mechanism, Prismatic
 from ..structure import Structure, structure_of
 from .assembly import assembly_plans, place_group
@@ -356,8 +357,8 @@ def analyze(
     _check_law_domains(mech, phi)
     plans = assembly_plans(mech)
     group_ids = range(len(structure.groups)) if outputs is None else \
-        structure.needed_groups(_links_of(mech, outputs))
-    run = _run_blocks(mech, structure, plans, list(group_ids), phi, order)
+        structure.needed_groups(links_needed(mech, outputs))
+    run = run_blocks(mech, structure, plans, list(group_ids), phi, order)
     for i in group_ids:
         group = structure.groups[i]
         _check_continuity(group, run.signs[i], plans[i].branches(phi), run.solved[i], phi, mech.coordinate)
@@ -383,7 +384,7 @@ def _check_law_domains(mech: Mechanism, phi: np.ndarray) -> None:
         if law.domain is None:
             continue
         low, high = law.domain
-        outside = (phi < low - 1e-9) | (phi > high + 1e-9)
+        outside = (phi < low - ANGLE_TOL) | (phi > high + ANGLE_TOL)
         if outside.any():
             shown = ", ".join(f"{v:.6g}" for v in np.degrees(phi[outside][:5]))
             raise InputError(f"mechanism '{mech.name}': input angle(s) {shown} deg lie outside the table of "
@@ -404,7 +405,8 @@ def input_sweep(mech: Mechanism) -> Motion:
     return cache["sweep"]
 
 
-def _links_of(mech: Mechanism, outputs: Iterable[str]) -> list[str]:
+def links_needed(mech: Mechanism, outputs: Iterable[str]) -> list[str]:
+    """The links whose poses the named outputs (links, points, quantities such as ``B.x``) need."""
     links = []
     for name in outputs:
         if name in mech.links:
@@ -425,7 +427,7 @@ BLOCK = 8192
 
 @dataclass
 class _Run:
-    """What :func:`_run_blocks` computed, over all N positions."""
+    """What :func:`run_blocks` computed, over all N positions."""
 
     poses: dict[str, np.ndarray]
     first: dict[str, np.ndarray] | None
@@ -437,7 +439,7 @@ class _Run:
     solved: dict[int, np.ndarray]    # group index -> the group's own status (N,)
 
 
-def _run_blocks(mech: Mechanism, structure: Structure, plans, group_ids: list[int], phi: np.ndarray,
+def run_blocks(mech: Mechanism, structure: Structure, plans, group_ids: list[int], phi: np.ndarray,
                 order: int, structure_at=None) -> _Run:
     """Solve the groups ``group_ids`` in order at the angles ``phi``, :data:`BLOCK` positions at a
     time, into arrays allocated once (links' values in columns of ``(N, 3)`` arrays).

@@ -25,7 +25,7 @@ from numpy.typing import ArrayLike
 from assur.base import point_analogs
 
 from ..errors import InputError
-from ..kinematics.batch import VariantMotion, _per_position, link_points
+from ..kinematics.batch import VariantMotion, link_points, repeat_per_angle
 from .loads import LoadTerm, loads_of
 from .reactions import Reactions, reactions_under, virtual_power_residual
 
@@ -166,7 +166,7 @@ def variant_reactions(
             eps_k = motion.second[k][:, 2] * w**2 + motion.first[k][:, 2] * e
             terms.append(LoadTerm(k, center, -m[:, None] * acc, -J * eps_k, "inertia", f"Fi{k}"))
     for k, point, value in link_points(mech, forces or {}, "forces", "forces (Fx, Fy)"):
-        local = _per_position(variants.geometry[k][point], n)
+        local = repeat_per_angle(variants.geometry[k][point], n)
         force = values(value, f"forces['{k}']['{point}']", (2,))
         terms.append(LoadTerm(k, local, force, np.zeros(len(force)), "external", f"F{point}"))
     for k, value in (moments or {}).items():
@@ -203,5 +203,5 @@ def _center(variants: VariantMotion, link: str, given, shape: tuple[int, int]) -
     base = variants.mechanism.links[link]
     on = [p for p, xy in base.points.items() if np.allclose(xy, base.center_of_mass, rtol=0, atol=0)]
     if on:
-        return _per_position(variants.geometry[link][sorted(on)[0]], n)
+        return repeat_per_angle(variants.geometry[link][sorted(on)[0]], n)
     return np.broadcast_to(np.asarray(base.center_of_mass, float), (count * n, 2))

@@ -416,7 +416,7 @@ def _diagram(mech: Mechanism, raw: Any, quantity: str | None, where: str, proble
     except (LinkageError, ValueError) as exc:
         problems.append(f"{where}: {exc}")
         return None
-    if ext.stroke <= 1e-9 * (1.0 if quantity.endswith(".theta") else mech.size):  # rad or m
+    if not ext.moves(mech.size):
         problems.append(f"{where}: the working direction {raw_working!r} is never taken: "
                         f"{quantity} does not move (stroke {ext.stroke:.3g})")
         return None

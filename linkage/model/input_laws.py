@@ -25,10 +25,11 @@ from functools import cached_property
 
 import numpy as np
 
-__all__ = ["InputLaw", "table_problems"]
+__all__ = ["ANGLE_TOL", "InputLaw", "table_problems"]
 
 TWO_PI = 2 * math.pi
-#: two table angles this close (rad) are one (a table that spans a turn "exactly")
+#: two input angles this close (rad) are one: a table that spans a turn "exactly", an angle at the
+#: end of a law's domain
 ANGLE_TOL = 1e-9
 
 

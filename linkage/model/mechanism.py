@@ -28,7 +28,7 @@ from typing import Any, Iterator, Mapping
 import networkx as nx
 
 from ..errors import SchemeError
-from .input_laws import InputLaw
+from .input_laws import ANGLE_TOL, InputLaw
 from .numbers import Vec
 
 __all__ = [
@@ -506,7 +506,7 @@ def law_problems(mech: Mechanism) -> list[str]:
             continue
         low, high = law.domain
         span = mech.input_range
-        inside = span is not None and low - 1e-9 <= min(span) and max(span) <= high + 1e-9
+        inside = span is not None and low - ANGLE_TOL <= min(span) and max(span) <= high + ANGLE_TOL
         if not inside:
             given = "none" if span is None else f"[{math.degrees(span[0]):.10g}, {math.degrees(span[1]):.10g}] deg"
             problems.append(f"input law of link '{link}': its table holds for phi in [{math.degrees(low):.10g}, "

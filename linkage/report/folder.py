@@ -22,6 +22,8 @@ from typing import Any
 
 import numpy as np
 
+from assur.base import OK
+
 from ..errors import InputError, LinkageError
 from ..model.mechanism import Mechanism, Prismatic
 from ..model.scheme import dumps, section_of
@@ -173,7 +175,7 @@ class _Work:
     def mechanism_pictures(self) -> None:
 
         motion = self.kinematics.motion
-        ok = np.flatnonzero(motion.status == 0)
+        ok = np.flatnonzero(motion.status == OK)
         if not len(ok):
             self.report.notes.append("the mechanism drawings: left out (no position of the table assembles)")
             return

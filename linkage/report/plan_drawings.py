@@ -36,6 +36,8 @@ from typing import Iterable, Mapping, Sequence
 
 import numpy as np
 
+from assur.base import OK
+
 from ..errors import InputError
 from ..kinetostatics.plans import POLE, ForcePolygon, Plans
 from .drawing import convex_hull, draw_mechanism
@@ -592,7 +594,7 @@ def _check(plans: Plans, position: int) -> int:
     if not isinstance(position, (int, np.integer)) or not -n <= position < n:
         raise InputError(f"position must be an index of the {n} analysed angles, got {position!r}")
     i = int(position) % n
-    if plans.motion.status[i] != 0:
+    if plans.motion.status[i] != OK:
         raise InputError(f"mechanism '{plans.motion.mechanism.name}' is not assembled or is singular at the "
                          f"input angle {np.degrees(plans.motion.phi[i]):.6g} deg: it has no plans there")
     return i

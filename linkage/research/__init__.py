@@ -10,8 +10,16 @@ every analysis stage and the report's tables. The public API is exported here.
 """
 
 from .assignments import Assignment, PairKind, Reference, assignments, reference_positions
-from .enumeration import (COLUMN_UNITS, CRANK_FACTORS, DEFAULT_OMEGA, Combination, Enumeration, Rejected,
-                          enumerate_chain, measure)
+from .enumeration import (
+                          COLUMN_UNITS,
+                          CRANK_FACTORS,
+                          DEFAULT_OMEGA,
+                          Combination,
+                          Enumeration,
+                          Rejected,
+                          enumerate_chain,
+                          measure,
+)
 from .placement import MIN_CONDITIONING, build_combination
 
 __all__ = [

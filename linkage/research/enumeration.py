@@ -36,9 +36,17 @@ from ..model.scheme import dumps, load, loads
 from ..report import format_columns
 from ..structure import Structure
 from .assignments import Assignment, Reference, assignments, reference_positions
-from .geometry import COINCIDENT, one_line, output_candidates, solvable
-from .placement import (CONDITION_TRIALS, MIN_CONDITIONING, Placement, declared_combination, placement,
-                        singular_words, too_close_to_singular, tracked_groups)
+from .geometry import one_line, output_candidates, solvable
+from .placement import (
+    CONDITION_TRIALS,
+    MIN_CONDITIONING,
+    Placement,
+    declared_combination,
+    placement,
+    singular_words,
+    too_close_to_singular,
+    tracked_groups,
+)
 
 __all__ = [
     "COLUMN_UNITS",
@@ -162,10 +170,11 @@ def _stroke_of(mech: Mechanism, candidates: list[str]) -> tuple[str, float | Non
     ``(quantity, stroke in m or deg, note)``; the first candidate, None and why when none has one."""
     for quantity in candidates:
         try:
-            stroke = extreme_positions(mech, quantity).stroke
+            ext = extreme_positions(mech, quantity)
         except LinkageError:  # constant, or monotonic: a link that turns fully
             continue
-        if stroke > COINCIDENT * (1.0 if quantity.endswith(".theta") else mech.size):   # rad or m
+        if ext.moves(mech.size):
+            stroke = ext.stroke
             return quantity, math.degrees(stroke) if quantity.endswith(".theta") else stroke, ""
     return candidates[0], None, f"no stroke: {', '.join(candidates)} stay constant or turn fully"
 
