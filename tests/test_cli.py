@@ -44,6 +44,18 @@ def analyze_csv(capsys, scheme, *options):
     return read_csv(out)
 
 
+def turning_sense(scheme):
+    """+1 / -1: the sense a crank scheme's tables turn in, read from its file (not from the
+    library): the sign of the declared [dynamics] mean_speed or mean_rpm, +1 without one. The
+    tables give the first analogs per rad turned in that sense, dq/dpsi = sense * dq/dphi
+    (docs/conventions.md), second analogs unchanged."""
+    import tomllib
+
+    dynamics = tomllib.loads(linkage.shipped_schemes()[scheme].read_text(encoding="utf-8")).get("dynamics", {})
+    speed = dynamics.get("mean_speed", dynamics.get("mean_rpm", 1.0))
+    return -1.0 if speed < 0 else 1.0
+
+
 def slider_crank_B_x(phi):
     """x of the slider: A = l1 (cos, sin), |AB| = l2, B on y = e, B right of A."""
     return L1 * np.cos(phi) + np.sqrt(L2**2 - (E_OFF - L1 * np.sin(phi)) ** 2)
@@ -230,9 +242,12 @@ def test_default_start_is_the_declared_extreme(capsys, scheme):
 
 @pytest.mark.parametrize("scheme", SHIPPED)
 def test_analogs_match_finite_differences_of_positions(capsys, scheme):
-    """x' and x'' of every column against five-point differences of the positions (docs/methods.md#checks)."""
+    """x' and x'' of every column against five-point differences of the positions (docs/methods.md#checks):
+    the differences over the absolute input angle phi, times the sense of rotation for the first
+    analogs (the table's are per rad turned, d/dpsi)."""
     if not linkage.load(scheme).coordinate.is_angle:
         return _slide_analogs_match_finite_differences(capsys, scheme)
+    sense = turning_sense(scheme)
     phi0_deg, h_deg = 17.0, 0.5
     samples = [analyze_csv(capsys, scheme, "--positions", "1", "--start", repr(phi0_deg + k * h_deg))
                for k in (-2, -1, 0, 1, 2)]
@@ -249,7 +264,7 @@ def test_analogs_match_finite_differences_of_positions(capsys, scheme):
         d1 = (values[0] - 8 * values[1] + 8 * values[3] - values[4]) / (12 * h)
         d2 = (-values[0] + 16 * values[1] - 30 * values[2] + 16 * values[3] - values[4]) / (12 * h * h)
         tol = 1e-6 * (1.0 if name.endswith(".theta") else size)
-        assert at[name + "'"][2] == pytest.approx(d1, abs=tol), name
+        assert at[name + "'"][2] == pytest.approx(sense * d1, abs=tol), name
         assert at[name + "''"][2] == pytest.approx(d2, abs=10 * tol), name
 
 

@@ -667,3 +667,48 @@ def test_to_dict_returns_an_independent_copy_of_the_sections():
     data["loads"]["gravity"][1] = 0.0
     assert dynamics_of(mech).inertia_0 == I0_DECLARED
     assert mech.extra["loads"]["gravity"] == [0.0, -9.81]
+
+
+BARE = """
+name = "bare"
+input = "1"
+output = "B.x"
+[links.0]
+points = { O = [0.0, 0.0] }
+guides.g = { through = [0.0, 0.0], angle_deg = 0 }
+[links.1]
+line = ["O", "A"]
+length = 0.1
+[links.2]
+line = ["A", "B"]
+length = 0.3
+[links.3]
+points.B = [0.0, 0.0]
+[pairs.O]
+links = ["0", "1"]
+[pairs.A]
+links = ["1", "2"]
+[pairs.B]
+links = ["2", "3"]
+[pairs.s]
+kind = "P"
+links = ["0", "3"]
+guide = "g"
+at = "B"
+[assembly.B]
+from = "O"
+towards_deg = 0
+[dynamics]
+mean_rpm = 60
+delta = 0.05
+inertia_0 = 2.0
+"""
+
+
+def test_a_machine_without_loads_or_masses_has_no_energy_swing_and_no_ratio_to_divide():
+    """No loads and no masses: the energy never swings, so both methods need no constant inertia
+    (closed form: I' = 0) and the course/exact ratio is undefined (None), not a ZeroDivisionError."""
+    report = run_dynamics(linkage.loads(BARE), "course")
+    summary = report.summary()
+    assert summary["required_constant_inertia"] == 0.0 and summary["exact_required_constant_inertia"] == 0.0
+    assert summary["course_vs_exact_inertia"] is None

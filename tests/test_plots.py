@@ -201,9 +201,12 @@ def test_drawing_refuses_what_it_cannot_draw():
 def test_column_words_name_the_quantity_and_its_unit():
     mech = linkage.load("slider_crank")
     assert describe_column("B.x", mech).axis == "slider position $x_{\\mathrm{B}}$, m"
-    assert describe_column("B.x'").legend == "velocity analog of B along x $x'_{\\mathrm{B}}$ (m/rad)"
-    assert describe_column("A.y''").axis == "acceleration analog of A along y $y''_{\\mathrm{A}}$, m/rad²"
-    assert describe_column("phi_deg", mech).axis == "crank angle from the start $\\varphi$, deg"
+    # analogs per rad turned, psi: the x axis of every diagram (docs/conventions.md)
+    assert describe_column("B.x'").legend == ("velocity analog of B along x $x'_{\\mathrm{B}} = dx_{\\mathrm{B}}/d\\psi$ "
+                                              "(m/rad, per rad of crank rotation)")
+    assert describe_column("A.y''").axis == "acceleration analog of A along y $d^2y_{\\mathrm{A}}/d\\psi^2$, m/rad²"
+    assert describe_column("phi_deg", mech).axis == "crank angle turned from position 1 $\\psi$, deg"
+    assert describe_column("T.x'", linkage.load("cylinder_boom")).legend.endswith("/ds$ (m/m, per m of cylinder travel)")
     assert describe_column("2.theta'", mech).words == "angular velocity analog of coupler 2"
     assert describe_column("3.theta", linkage.load("four_bar")).words == "angle of rocker 3"
     assert describe_column("slide.R").axis == "reaction in pair slide $R_{\\mathrm{slide}}$, N"

@@ -414,7 +414,7 @@ def test_given_variants_errors(tmp_path, text, says):
 
 def test_shipped_templates_are_found_and_not_listed_as_schemes():
     shipped = shipped_templates()
-    assert {"press_slider_crank", "shaper_two_dyad"} <= set(shipped)
+    assert {"press_slider_crank", "shaper_two_dyad", "press_crank_rocker"} <= set(shipped)
     assert not set(shipped) & set(shipped_schemes())
     with pytest.raises(SchemeError, match=r"unknown template 'press_slider'.*did you mean 'press_slider_crank'\?"):
         load_template("press_slider")
@@ -422,7 +422,7 @@ def test_shipped_templates_are_found_and_not_listed_as_schemes():
         linkage.load(shipped["press_slider_crank"])
 
 
-@pytest.mark.parametrize("name", ["press_slider_crank", "shaper_two_dyad"])
+@pytest.mark.parametrize("name", ["press_slider_crank", "shaper_two_dyad", "press_crank_rocker"])
 def test_shipped_template_declares_what_the_generator_needs(name):
     t = load_template(name)
     assert t.name == name and t.description and len(t.tasks) >= 5

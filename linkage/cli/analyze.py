@@ -26,9 +26,11 @@ def add(sub) -> None:
     p = sub.add_parser(
         "analyze", help="kinematics table: positions, velocity and acceleration analogs",
         formatter_class=HelpFormatter, epilog=CONVENTIONS,
-        description="Positions and first / second transfer functions (analogs, d/dphi) of every "
+        description="Positions and first / second transfer functions (analogs) of every "
                     "named point, moving link angle and prismatic slide, at N equal steps of the "
-                    "input angle phi (docs/conventions.md). Columns: i, phi_deg; P.x P.y P.x' P.y' "
+                    "input angle; the analogs are d/dpsi, per rad turned from position 1 in the "
+                    "direction of rotation (psi = phi_deg in rad; d/ds for a slide input), "
+                    "docs/conventions.md. Columns: i, phi_deg; P.x P.y P.x' P.y' "
                     "P.x'' P.y''; L.theta L.theta' L.theta''; K.s K.s' K.s'' (m, rad). The table "
                     "for people shows the absolute input angle, the scheme's output and the "
                     "moving links and slides with their analogs, as many as fit.")
@@ -65,6 +67,7 @@ def run(args: argparse.Namespace) -> int:
     if args.format == "table":
         phi = results.motion.phi
         meta = {"scheme": mech.name, "formula": meta["formula"],
-                "start": start_line(mech, phi, meta["start"], meta["positions"], declared_rotation(mech))}
+                "start": start_line(mech, phi, meta["start"], meta["positions"], declared_rotation(mech)),
+                "analogs": meta["analogs"]}
     emit(results.columns, args, meta, _analyze_view(mech))
     return 0

@@ -59,7 +59,8 @@ table conventions (docs/conventions.md):
   L.theta      absolute angle of link L, CCW from +x, rad, in (-pi, pi]; for the input link
                it is the absolute input angle phi = phi0 + direction * phi_deg
   K.angle_deg  direction of a force, deg CCW from +x, in (-180, 180]
-  q' q''       analogs dq/dphi, d2q/dphi2, per radian of the input angle (m/rad, rad/rad ...)
+  q' q''       analogs d/dpsi, d2/dpsi2, psi = phi_deg in rad (m/rad, rad/rad ...): q' is the
+               slope of q over phi_deg for either sense (the Python API's Motion: d/dphi)
   units        SI: m, rad, N, N m, kg m^2, s (deg where the name ends in _deg); the table
                for people gives each column's unit in brackets under its name, JSON under
                "units"

@@ -1,8 +1,8 @@
 """The overview of a course's variants: their table as an A4 PDF (matplotlib only).
 
 :func:`overview_pdf` -- the table of all variants of a course: A4 (landscape when the table is
-wide), at most :data:`ROWS_PER_PAGE` rows a page, the header on every page, "page k of K", then
-the notes. :func:`overview_figures` gives the same pages as matplotlib figures. Typeset with
+wide), at most :data:`ROWS_PER_PAGE` rows a page, the header (each column's name, its unit under
+it) on every page, "page k of K", then the notes. :func:`overview_figures` gives the same pages as matplotlib figures. Typeset with
 :mod:`~linkage.course.typesetting`, like the assignment sheets (:mod:`~linkage.course.sheets`).
 
 **Reproducible.** The same input gives byte-identical PDFs (no dates, fixed metadata, embedded
@@ -64,6 +64,7 @@ class _Table:
     font: float
     widths: list[float]
     header: list[list[str]]
+    units: list[str]
     cells: list[list[list[str]]]
     right: list[bool]
 
@@ -75,17 +76,19 @@ class _Table:
 PAD = 0.07   # inches of padding at each side of a cell
 
 
-def _measure_table(measure: Measure, header: list[str], rows: list[list[str]], room: float) -> _Table:
+def _measure_table(measure: Measure, header: list[str], rows: list[list[str]], room: float,
+                   units: list[str]) -> _Table:
     """Column widths (inches) at the largest font from 9 pt down to 6 pt with which the table fits
-    ``room``: each column as wide as its widest cell and the widest piece of its name (names break
-    between words and after underscores), then whole names on one line while the room lasts; still
-    too wide at 6 pt, the columns share the room by their needs and cells wrap."""
+    ``room``: each column as wide as its widest cell, its unit and the widest piece of its name
+    (names break between words and after underscores), then whole names on one line while the
+    room lasts; still too wide at 6 pt, the columns share the room by their needs and cells wrap."""
     right = [all(_is_number(r[c]) for r in rows if r[c].strip()) and any(r[c].strip() for r in rows)
              for c in range(len(header))]
     font = 9.0
     while True:
         cell = [max([measure.width(r[c], font) for r in rows] + [0.0]) for c in range(len(header))]
-        word = [max([measure.width(w, font, True) for w in _name_pieces(h)] + [0.0]) for h in header]
+        word = [max([measure.width(w, font, True) for w in _name_pieces(h)] + [measure.width(u, font)])
+                for h, u in zip(header, units, strict=True)]
         full = [measure.width(h, font, True) for h in header]
         need = [max(c, w) + 2 * PAD for c, w in zip(cell, word, strict=True)]
         if sum(need) <= room or font <= 6.0:
@@ -103,7 +106,7 @@ def _measure_table(measure: Measure, header: list[str], rows: list[list[str]], r
         widths = [w + spare * w / sum(widths) for w in widths]
     wrapped_header = [_wrap_name(measure, h, w - 2 * PAD, font) for h, w in zip(header, widths, strict=True)]
     cells = [[measure.wrap(r[c], widths[c] - 2 * PAD, font) for c in range(len(header))] for r in rows]
-    return _Table(font, widths, wrapped_header, cells, right)
+    return _Table(font, widths, wrapped_header, list(units), cells, right)
 
 
 def _name_pieces(name: str) -> list[str]:
@@ -129,12 +132,17 @@ def _wrap_name(measure: Measure, name: str, width: float, size: float) -> list[s
     return [part for line in lines for part in measure.wrap(line, width, size, True)] or [""]
 
 
-def _checked_overview_input(title, header, rows, notes) -> tuple[list[str], list[list[str]], list[str]]:
+def _checked_overview_input(title, header, rows, notes, units) -> tuple[list[str], list[list[str]], list[str],
+                                                                        list[str]]:
     if not isinstance(title, str) or not title.strip():
         raise InputError(f"the overview's title must be a non-empty string, got {title!r}")
     header = list(header)
     if not header or not all(isinstance(h, str) for h in header):
         raise InputError(f"the overview's header must be a non-empty sequence of strings, got {header!r}")
+    units = [""] * len(header) if units is None else units
+    if isinstance(units, str) or len(units) != len(header) or not all(isinstance(u, str) for u in units):
+        raise InputError(f"the overview's units must be {len(header)} strings (one per column of the header "
+                         f"{header}; '' for none), got {units!r}")
     checked = []
     for k, row in enumerate(rows, start=1):
         row = list(row) if not isinstance(row, str) else None
@@ -144,7 +152,7 @@ def _checked_overview_input(title, header, rows, notes) -> tuple[list[str], list
         checked.append(row)
     if isinstance(notes, str) or not all(isinstance(n, str) for n in notes):
         raise InputError(f"the overview's notes must be a sequence of strings, got {notes!r}")
-    return header, checked, list(notes)
+    return header, checked, list(notes), list(units)
 
 
 def _pages_of_rows(heights: Sequence[float], room: float) -> list[list[int]]:
@@ -161,24 +169,25 @@ def _pages_of_rows(heights: Sequence[float], room: float) -> list[list[int]]:
 
 
 def overview_figures(*, title: str, header: Sequence[str], rows: Sequence[Sequence[str]],
-                     notes: Sequence[str] = ()) -> list:
+                     notes: Sequence[str] = (), units: Sequence[str] | None = None) -> list:
     """The pages of :func:`overview_pdf` as A4 matplotlib figures, each with an Agg canvas of its
     own."""
-    header, rows, notes = _checked_overview_input(title, header, rows, notes)
+    header, rows, notes, units = _checked_overview_input(title, header, rows, notes, units)
     with page_style():
-        return _overview_pages(title, header, rows, notes)
+        return _overview_pages(title, header, rows, notes, units)
 
 
-def _overview_pages(title: str, header: list[str], rows: list[list[str]], notes: list[str]) -> list:
+def _overview_pages(title: str, header: list[str], rows: list[list[str]], notes: list[str],
+                    units: list[str]) -> list:
     measure = Measure()
     portrait_room = A4[0] - 2 * SIDE
-    table = _measure_table(measure, header, rows, portrait_room)
+    table = _measure_table(measure, header, rows, portrait_room, units)
     landscape = table.width > portrait_room + 1e-9 or table.font < 9.0
     if landscape:
-        table = _measure_table(measure, header, rows, A4[1] - 2 * SIDE)
+        table = _measure_table(measure, header, rows, A4[1] - 2 * SIDE, units)
     page_w, page_h = (A4[1], A4[0]) if landscape else A4
     line = line_height(table.font)
-    head_h = max(len(h) for h in table.header) * line + 0.08
+    head_h = (max(len(h) for h in table.header) + any(table.units)) * line + 0.08
     title_lines = measure.wrap(title, page_w - 2 * SIDE, HEADING + 2, bold=True)
     title_h = len(title_lines) * line_height(HEADING + 2) + 0.12
     room = page_h - TOP - BOTTOM - title_h - head_h
@@ -240,10 +249,13 @@ def _draw_table_page(fig, table: _Table, indices: list[int], heights: list[float
     """The header and the rows ``indices``; the top of what comes below, inches."""
     x = SIDE + np.concatenate([[0.0], np.cumsum(table.widths)])
     line = line_height(table.font)
+    unit_top = top - 0.03 - max(len(h) for h in table.header) * line   # the units on one line under the names
     for c, lines in enumerate(table.header):
         anchor, ha = (x[c + 1] - PAD, "right") if table.right[c] else (x[c] + PAD, "left")
         write(fig, anchor, top - 0.03, "\n".join(lines), table.font, bold=True, ha=ha, gid="header",
                va="top")
+        if table.units[c]:
+            write(fig, anchor, unit_top, table.units[c], table.font, ha=ha, gid="header-unit", va="top")
     top -= head_h
     rule(fig, x[0], x[-1], top, lw=0.9, colour="0.15")
     for n, k in enumerate(indices):
@@ -272,7 +284,7 @@ def _draw_notes(fig, lines: list[tuple[str, str]], top: float) -> None:
 
 
 def overview_pdf(*, title: str, header: Sequence[str], rows: Sequence[Sequence[str]],
-                 notes: Sequence[str] = ()) -> bytes:
+                 notes: Sequence[str] = (), units: Sequence[str] | None = None) -> bytes:
     """The table of all variants as an A4 PDF, then the notes.
 
     Portrait when the table fits the width of a portrait page at 9 pt, else landscape (down to
@@ -287,6 +299,9 @@ def overview_pdf(*, title: str, header: Sequence[str], rows: Sequence[Sequence[s
         The overview's title; also the footer and the PDF's title.
     header : sequence of str
         The column names.
+    units : sequence of str, optional
+        Printed under each column's name, as given (``"[kg·m²]"``; ``""`` for nothing); default
+        none.
     rows : sequence of sequences of str
         One row of texts per variant, as many as the header has columns.
     notes : sequence of str
@@ -300,10 +315,10 @@ def overview_pdf(*, title: str, header: Sequence[str], rows: Sequence[Sequence[s
     Raises
     ------
     InputError
-        A row of another length than the header, or a value that is not text.
+        A row (or the units) of another length than the header, or a value that is not text.
     PlotExtraMissing
         matplotlib is not installed.
     """
-    pages = overview_figures(title=title, header=header, rows=rows, notes=notes)
+    pages = overview_figures(title=title, header=header, rows=rows, notes=notes, units=units)
     with page_style():
         return pdf_bytes(pages, title)

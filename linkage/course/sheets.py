@@ -1,13 +1,22 @@
 """Printable assignment sheets: one variant's A4 PDF, the mechanism drawn to scale (matplotlib only).
 
-:func:`assignment_sheet` -- one variant's sheet: the title and the mechanism in words, the
-mechanism **drawn to a true standard scale** (1:1, 1:2, 1:2.5, 1:4, 1:5, 1:10 ... or 2:1, 5:1
-... for tiny mechanisms) at one table position with the sense of rotation of the input link, the
-output point's path and the scale written out, so that a student measures lengths on the printed
-page with a ruler; the data table and the numbered tasks. One A4 portrait page, two when the
-text does not fit beside a drawing of useful size. :func:`sheet_figures` gives the same pages as
-matplotlib figures (for a PNG, or to inspect them). The overview of a set of variants is
-:mod:`~linkage.course.overview`'s; both are typeset with :mod:`~linkage.course.typesetting`.
+- :func:`assignment_sheet_from_given` -- a variant's sheet rendered from its ``given.json``
+  alone (:mod:`~linkage.course.given`): the title block with the variant and empty fields for
+  the student's name, group and date; the mechanism drawn to scale; the tasks; every datum the
+  answer key depends on, in tables of quantity, symbol, value and unit; every load diagram as a
+  small graph over the stroke with its zones and its table of values
+  (:mod:`~linkage.course.diagram_blocks`); as many pages as the data need, numbered.
+- :func:`assignment_sheet` -- a sheet of a mechanism with a data table and tasks given as text.
+
+Both draw the mechanism **to a true standard scale** (1:1, 1:2, 1:2.5, 1:4, 1:5, 1:10 ... or
+2:1, 5:1 ... for tiny mechanisms), the largest that fits the room page 1 leaves under the title,
+at one table position with the sense of rotation of the input link, the output point's path and
+the scale written out, so that a student measures lengths on the printed page with a ruler. What
+follows the drawing goes under it while it fits, and to the next pages otherwise (a table or a
+list of tasks longer than a page is split between rows). :func:`sheet_figures` and
+:func:`given_sheet_figures` give the same pages as matplotlib figures (for a PNG, or to inspect
+them). The overview of a set of variants is :mod:`~linkage.course.overview`'s; all are typeset
+with :mod:`~linkage.course.typesetting`.
 
 **To scale.** A4 is 210 x 297 mm and the figure is exactly that size, in inches; the drawing's
 axes are placed in inches and their limits set so that one metre of the mechanism is exactly
@@ -29,7 +38,7 @@ functions can run in worker processes. Without matplotlib they raise
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -41,6 +50,8 @@ from ..model.mechanism import Mechanism, Prismatic
 from ..model.scheme import section_of
 from ..report.drawing import Geometry, draw_mechanism, rail_hatch, support
 from ..report.results import declared_rotation, table_defaults, table_positions
+from .diagram_blocks import diagram_block
+from .given import scheme_from_given, sheet_rows
 from .typesetting import (
     A4,
     BOTTOM,
@@ -59,22 +70,18 @@ from .typesetting import (
     line_height,
     new_page,
     page_style,
+    paginate,
     pdf_bytes,
     rule,
-    shade,
+    table_block,
     write,
 )
 
-__all__ = ["assignment_sheet", "sheet_figures", "standard_scale", "scale_text", "table_motion"]
+__all__ = ["assignment_sheet", "assignment_sheet_from_given", "given_sheet_figures", "sheet_figures", "standard_scale",
+           "scale_text", "table_motion"]
 
 # the drawing's box: room for the y tick labels and axis label at the left, the x ones below
 AXES_LEFT, AXES_RIGHT, AXES_BELOW, AXES_ABOVE = 0.62, 0.12, 0.46, 0.08
-#: a drawing of at least this height (inches), or at the scale the page's width allows, keeps the
-#: text on the same page; else the text goes to a second page
-MIN_DRAWING = 2.6
-#: a scale this many times smaller than the one the page's width allows still keeps one page
-#: (one standard step: 1:2.5 -> 1:4 or 1:5 -> 1:10; not 1:5 -> 1:20)
-ONE_STEP = 2.0
 #: smallest height of the drawing's axes, inches (room for a few ticks on the y axis)
 MIN_AXES = 1.3
 #: height of the 100 mm check bar under the drawing, inches
@@ -189,67 +196,54 @@ class _Sheet:
     tasks: list[str]
     width: float = field(default=A4[0] - 2 * SIDE)
 
-    def heading(self, text: str) -> Block:
-        def draw(fig, top):
-            write(fig, SIDE, top, text, HEADING, bold=True)
-        return Block(line_height(HEADING) + 0.04, draw, gap=0.02)
-
-    def title_block(self) -> Block:
-        title = self.measure.wrap(self.title, self.width, TITLE, bold=True)
+    def title_block(self, size: float = TITLE) -> Block:
+        title = self.measure.wrap(self.title, self.width, size, bold=True)
         sub = self.measure.wrap(self.subtitle, self.width, TEXT) if self.subtitle.strip() else []
-        height = len(title) * line_height(TITLE) + len(sub) * line_height(TEXT) + (0.06 if sub else 0.0)
+        height = len(title) * line_height(size) + len(sub) * line_height(TEXT) + (0.06 if sub else 0.0)
 
         def draw(fig, top):
-            write(fig, SIDE, top, "\n".join(title), TITLE, bold=True, gid="title")
+            write(fig, SIDE, top, "\n".join(title), size, bold=True, gid="title")
             if sub:
-                write(fig, SIDE, top - len(title) * line_height(TITLE) - 0.06, "\n".join(sub), TEXT, colour="0.15",
-                       gid="subtitle")
+                write(fig, SIDE, top - len(title) * line_height(size) - 0.06, "\n".join(sub), TEXT, colour="0.15",
+                      gid="subtitle")
         return Block(height, draw, gap=0.14)
 
     def data_block(self) -> Block:
-        widths = self._data_columns()
-        rows = [[self.measure.wrap(text, w - 0.12, TABLE) for text, w in zip(row, widths, strict=True)]
-                for row in self.data]
-        heights = [max(len(cell) for cell in row) * line_height(TABLE) + 0.04 for row in rows]
-        head = line_height(TABLE) + 0.07
-        x = [SIDE, SIDE + widths[0], SIDE + widths[0] + widths[1]]
-
-        def draw(fig, top):
-            for k, text in enumerate(("quantity", "value", "unit")):
-                write(fig, x[k] + 0.06, top - 0.03, text, TABLE, bold=True)
-            y = top - head
-            rule(fig, SIDE, SIDE + sum(widths), y, lw=0.8, colour="0.2")
-            for k, ((label, value, unit), h) in enumerate(zip(rows, heights, strict=True)):
-                if k % 2:
-                    shade(fig, SIDE, y - h, sum(widths), h)
-                write(fig, x[0] + 0.06, y - 0.025, "\n".join(label), TABLE, gid="data-label")
-                write(fig, x[1] + 0.06, y - 0.025, "\n".join(value), TABLE, gid="data-value")
-                write(fig, x[2] + 0.06, y - 0.025, "\n".join(unit), TABLE, gid="data-unit")
-                y -= h
-            rule(fig, SIDE, SIDE + sum(widths), y, lw=0.8, colour="0.2")
-        return Block(head + sum(heights) + 0.02, draw)
-
-    def _data_columns(self) -> tuple[float, float, float]:
-        """Widths of the label, value and unit columns, inches: value and unit as wide as their
-        longest text (at most a third of the width together), the label the rest."""
+        """The data table (quantity, value, unit), headed "Data"; split between rows over pages."""
         value = max([self.measure.width(v, TABLE) for _, v, _ in self.data] + [self.measure.width("value", TABLE,
                                                                                                    True)])
         unit = max([self.measure.width(u, TABLE) for _, _, u in self.data] + [self.measure.width("unit", TABLE, True)])
         value, unit = min(value + 0.3, self.width / 5), min(unit + 0.3, self.width / 6)
-        return self.width - value - unit, value, unit
+        columns = [("quantity", "data-label", None, False), ("value", "data-value", value, False),
+                   ("unit", "data-unit", unit, False)]
+        return table_block(self.measure, self.width, columns, self.data, heading="Data")
 
-    def tasks_block(self) -> Block:
+    def tasks_block(self, tasks: Sequence[str] | None = None, first: int = 1) -> Block:
+        """The numbered tasks, headed "Tasks"; split between tasks over pages."""
+        tasks = self.tasks if tasks is None else list(tasks)
         indent = self.measure.width(f"{len(self.tasks)}. ", TEXT) + 0.04
-        items = [self.measure.wrap(t, self.width - indent, TEXT) for t in self.tasks]
+        items = [self.measure.wrap(t, self.width - indent, TEXT) for t in tasks]
         heights = [len(lines) * line_height(TEXT) + 0.05 for lines in items]
+        head = line_height(HEADING) + 0.06
 
         def draw(fig, top):
-            y = top
-            for k, (lines, h) in enumerate(zip(items, heights, strict=True), start=1):
+            write(fig, SIDE, top, "Tasks" if first == 1 else "Tasks (continued)", HEADING, bold=True, gid="heading")
+            y = top - head
+            for k, (lines, h) in enumerate(zip(items, heights, strict=True), start=first):
                 write(fig, SIDE + indent - 0.04, y, f"{k}.", TEXT, ha="right")
                 write(fig, SIDE + indent, y, "\n".join(lines), TEXT, gid="task")
                 y -= h
-        return Block(sum(heights), draw)
+
+        def split(room: float):
+            fits = max((k for k in range(len(items) + 1) if head + sum(heights[:k]) <= room), default=0)
+            if fits == 0:
+                return None, block
+            if fits == len(items):
+                return block, None
+            return self.tasks_block(tasks[:fits], first), self.tasks_block(tasks[fits:], first + fits)
+
+        block = Block(head + sum(heights) - 0.05, draw, split=split)      # no space under the last task
+        return block
 
 
 # ----------------------------------------------------------------------------------------------
@@ -526,9 +520,28 @@ def _checked_sheet_input(title, data, tasks, subtitle) -> tuple[list[tuple[str, 
     return rows, list(tasks)
 
 
+def _composed(sheet: _Sheet, drawing: _Drawing, head: list[Block], body: list[Block], numbered: bool) -> list:
+    """The pages: ``head`` and the drawing on page 1, at the largest standard scale that fits the
+    room page 1 leaves under ``head``; then ``body``, block after block, on as many pages as it
+    needs (:func:`~linkage.course.typesetting.paginate`); a footer with the title (and "page k of
+    n" when ``numbered``)."""
+    usable = A4[1] - TOP - BOTTOM - 0.1 - _drawing_overhead(sheet, drawing)
+    room = usable - sum(b.height + b.gap for b in head)
+    scale = _fit_scale(drawing, _box_width(sheet), max(room, MIN_AXES))
+    continued = _Sheet(sheet.measure, f"{sheet.title} (continued)", "", [], [])
+    pages = paginate([*head, _drawing_block(sheet, drawing, scale)], body,
+                     lambda: [continued.title_block(HEADING)])
+    figures = []
+    for k, blocks in enumerate(pages, start=1):
+        figures.append(new_page())
+        flow(figures[-1], blocks, A4[1] - TOP)
+        footer(figures[-1], sheet.measure, sheet.title, f"page {k} of {len(pages)}" if numbered else "")
+    return figures
+
+
 def sheet_figures(mechanism: Mechanism, *, title: str, data: Sequence[tuple[str, str, str]],
                   tasks: Sequence[str], subtitle: str = "", position: int = 0) -> list:
-    """The pages of :func:`assignment_sheet` as A4 matplotlib figures (one, or two).
+    """The pages of :func:`assignment_sheet` as A4 matplotlib figures.
 
     The drawing's axes are the figure's axes labelled ``"drawing"``; the scale is the text whose
     gid is ``"scale"``. Each figure has an Agg canvas of its own: ``fig.savefig("page.png")``.
@@ -537,76 +550,23 @@ def sheet_figures(mechanism: Mechanism, *, title: str, data: Sequence[tuple[str,
     with page_style():
         sheet = _Sheet(Measure(), title, subtitle, rows, task_list)
         drawing = _prepare_drawing(mechanism, position)
-        head = [sheet.title_block()]
-        data_blocks = [sheet.heading("Data"), sheet.data_block()] if rows else []
-        task_blocks = [sheet.heading("Tasks"), sheet.tasks_block()] if task_list else []
-        first, later, scale = _arrangement(sheet, drawing, head, data_blocks, task_blocks)
-        page_blocks = [[*head, _drawing_block(sheet, drawing, scale), *first]]
-        if later:
-            continued = _Sheet(sheet.measure, f"{title} (continued)", "", [], [])
-            page_blocks.append([continued.title_block(), *later])
-        for k, blocks in enumerate(page_blocks, start=1):
-            _check_fits(blocks, k, len(rows), len(task_list))
-        pages = []
-        for blocks in page_blocks:
-            pages.append(new_page())
-            flow(pages[-1], blocks, A4[1] - TOP)
-            footer(pages[-1], sheet.measure, title)
-    return pages
-
-
-def _check_fits(blocks: Sequence[Block], page: int, rows: int, tasks: int) -> None:
-    """InputError when the blocks run into the bottom margin of page ``page``."""
-    height = sum(b.height + b.gap for b in blocks) - blocks[-1].gap
-    room = A4[1] - TOP - BOTTOM
-    if height > room + 1e-9:
-        raise InputError(f"the assignment sheet does not fit on two A4 pages: page {page} needs {height:.2f} in of "
-                         f"the {room:.2f} in it has ({rows} data rows, {tasks} tasks); shorten the description, "
-                         "the labels or the tasks, or give fewer of them")
-
-
-def _arrangement(sheet: _Sheet, drawing: _Drawing, head: list[Block], data: list[Block], tasks: list[Block]):
-    """``(blocks after the drawing on page 1, blocks of page 2, scale)``.
-
-    One page when the room left by the text gives the drawing at least :data:`MIN_DRAWING` inches
-    of height, or a scale at most one standard step (a factor :data:`ONE_STEP`) below the one the
-    page's width allows; else the tasks, the data, or both go to page 2, whichever gives the larger
-    scale (in this order at a tie).
-    """
-    usable = A4[1] - TOP - BOTTOM - 0.1 - _drawing_overhead(sheet, drawing)
-    box = _box_width(sheet)
-
-    def room(blocks: list[Block]) -> float:
-        """Height left for the drawing's axes with these blocks under it, inches (may be < 0)."""
-        return usable - sum(b.height + b.gap for b in head + blocks)
-
-    def scale(blocks: list[Block]) -> tuple[float, float]:
-        return _fit_scale(drawing, box, max(room(blocks), MIN_AXES))
-
-    widest = scale([])
-    if not data + tasks:
-        return [], [], widest
-    one_page = scale(data + tasks)
-    if room(data + tasks) >= MIN_DRAWING or (room(data + tasks) >= MIN_AXES and
-                                             one_page[0] / one_page[1] * ONE_STEP >= widest[0] / widest[1]):
-        return data + tasks, [], one_page
-    options = [(data, tasks), (tasks, data), ([], data + tasks)] if data and tasks else [([], data + tasks)]
-    ranked = [(room(first) >= MIN_AXES, scale(first)[0] / scale(first)[1], -k) for k, (first, _) in enumerate(options)]
-    best = ranked.index(max(ranked))
-    return options[best][0], options[best][1], scale(options[best][0])
+        body = ([sheet.data_block()] if rows else []) + ([sheet.tasks_block()] if task_list else [])
+        return _composed(sheet, drawing, [sheet.title_block()], body, numbered=False)
 
 
 def assignment_sheet(mechanism: Mechanism, *, title: str, data: Sequence[tuple[str, str, str]],
                      tasks: Sequence[str], subtitle: str = "", position: int = 0) -> bytes:
     """One variant's assignment sheet: an A4 portrait PDF.
 
-    The page holds the title and subtitle; the mechanism drawn to the largest standard scale that
-    fits (the scale written above it, "The mechanism to scale 1:4") at a position of its declared
-    table (the scheme's [dynamics] positions, start and sense of rotation, as ``linkage analyze``
-    tabulates them), with a curved arrow for the input's sense of rotation, the output point's path
-    dashed, a caption in words and a 100 mm bar to check the print; the data table; the numbered
-    tasks; and the title as a footer. When the text leaves less than :data:`MIN_DRAWING` inches for
-    the drawing, the tasks (and if need be the data) go to a second page.
+    Page 1 holds the title and subtitle and the mechanism drawn to the largest standard scale that
+    fits the rest of the page (the scale written above it, "The mechanism to scale 1:4") at a
+    position of its declared table (the scheme's [dynamics] positions, start and sense of
+    rotation, as ``linkage analyze`` tabulates them), with a curved arrow for the input's sense of
+    rotation, the output point's path dashed, a caption in words and a 100 mm bar to check the
+    print; then the data table and the numbered tasks, under the drawing when they fit, else on
+    the pages after it (a table or a list of tasks longer than a page is split over pages); the
+    title as a footer. :func:`assignment_sheet_from_given` makes a variant's whole sheet from its
+    ``given.json``.
 
     Parameters
     ----------
@@ -638,3 +598,136 @@ def assignment_sheet(mechanism: Mechanism, *, title: str, data: Sequence[tuple[s
     pages = sheet_figures(mechanism, title=title, data=data, tasks=tasks, subtitle=subtitle, position=position)
     with page_style():
         return pdf_bytes(pages, title)
+
+
+# ----------------------------------------------------------------------------------------------
+# the sheet of a variant, from its given.json
+# ----------------------------------------------------------------------------------------------
+
+#: the fields a student fills in, and their shares of the line
+STUDENT_FIELDS = (("Student", 2.0), ("Group", 1.0), ("Date", 1.0))
+#: space between two fields, inches
+FIELD_GAP = 0.3
+
+
+def _title_block(sheet: _Sheet, given: Mapping[str, Any]) -> Block:
+    """The title with the variant (beside it when there is room, else under it) and the student's
+    fields to fill in."""
+    m = sheet.measure
+    variant = (f"Variant {given.get('variant', '')} · folder {given.get('folder', '')} · "
+               f"template {given.get('template', '')}")
+    beside = m.width(sheet.title, TITLE, True) + 0.3 + m.width(variant, TEXT) <= sheet.width
+    title = m.wrap(sheet.title, sheet.width, TITLE, bold=True)
+    labels = [m.width(f"{name}: ", TEXT, True) for name, _ in STUDENT_FIELDS]
+    room = sheet.width - sum(labels) - FIELD_GAP * (len(STUDENT_FIELDS) - 1)
+    share = sum(w for _, w in STUDENT_FIELDS)
+    fields = 0.34
+    height = len(title) * line_height(TITLE) + (0.0 if beside else line_height(TEXT) + 0.02) + fields
+
+    def draw(fig, top):
+        write(fig, SIDE, top, "\n".join(title), TITLE, bold=True, gid="title")
+        y = top - len(title) * line_height(TITLE)
+        if beside:
+            write(fig, SIDE + sheet.width, top - (TITLE - TEXT) / 72, variant, TEXT, colour="0.25", ha="right",
+                  gid="variant")
+        else:
+            write(fig, SIDE, y - 0.02, variant, TEXT, colour="0.25", gid="variant")
+            y -= line_height(TEXT) + 0.02
+        y -= fields - 0.08
+        x = SIDE
+        for (name, weight), label in zip(STUDENT_FIELDS, labels, strict=True):
+            write(fig, x, y, f"{name}:", TEXT, bold=True, va="baseline", gid="student-field")
+            length = room * weight / share
+            rule(fig, x + label, x + label + length, y - 0.04, lw=0.7, colour="0.2")
+            x += label + length + FIELD_GAP
+    return Block(height, draw, gap=0.16)
+
+
+def _description_block(sheet: _Sheet) -> Block:
+    """The mechanism in words (the template's description), under the drawing."""
+    lines = sheet.measure.wrap(sheet.subtitle, sheet.width, TEXT)
+
+    def draw(fig, top):
+        write(fig, SIDE, top, "\n".join(lines), TEXT, colour="0.15", gid="subtitle")
+    return Block(len(lines) * line_height(TEXT), draw, gap=0.16)
+
+
+def _data_table(sheet: _Sheet, sections: Sequence[tuple[str, Sequence[Mapping[str, str]]]]) -> Block:
+    """The data table: quantity, symbol, value, unit, in sections; split between rows over pages."""
+    m = sheet.measure
+    rows = [r for _, part in sections for r in part]
+    symbol = max([m.width(r["symbol"], TABLE, math=True) for r in rows] + [m.width("symbol", TABLE, True)]) + 0.2
+    value = min(max([m.width(r["value"], TABLE) for r in rows] + [m.width("value", TABLE, True)]) + 0.2,
+                sheet.width * 0.36)
+    unit = max([m.width(r["unit"], TABLE) for r in rows] + [m.width("unit", TABLE, True)]) + 0.2
+    columns = [("quantity", "data-label", None, False), ("symbol", "data-symbol", symbol, True),
+               ("value", "data-value", value, False), ("unit", "data-unit", unit, False)]
+    cells: list[tuple[str, ...]] = []
+    for title, part in sections:
+        cells.append((title,))
+        cells += [(r["quantity"], r["symbol"], r["value"], r["unit"]) for r in part]
+    return table_block(m, sheet.width, columns, cells, heading="Data", breakable=True)
+
+
+def _diagrams_heading(sheet: _Sheet, first: Block) -> Block:
+    """The heading of the load diagrams, kept on the page of the first diagram."""
+    def draw(fig, top):
+        write(fig, SIDE, top, "Load diagrams", HEADING, bold=True, gid="heading")
+        first.draw(fig, top - line_height(HEADING) - 0.1)
+    return Block(line_height(HEADING) + 0.1 + first.height, draw, first.gap)
+
+
+def given_sheet_figures(given: Mapping[str, Any], position: int = 0) -> list:
+    """The pages of :func:`assignment_sheet_from_given` as A4 matplotlib figures."""
+    title = str(given.get("title") or f"Assignment {given.get('variant', '')}")
+    rows, tasks = _checked_sheet_input(title, [], given.get("tasks", []), str(given.get("description", "")))
+    mech = scheme_from_given(given)
+    with page_style():
+        sheet = _Sheet(Measure(), title, str(given.get("description", "")), rows, tasks)
+        drawing = _prepare_drawing(mech, position)
+        body = [_description_block(sheet)] if sheet.subtitle.strip() else []
+        body += [sheet.tasks_block()] if tasks else []
+        grouped: dict[str, list] = {}
+        for row in sheet_rows(given):
+            if row["kind"] != "diagram":
+                grouped.setdefault(row["section"], []).append(row)
+        if grouped:
+            body.append(_data_table(sheet, list(grouped.items())))
+        diagrams = [diagram_block(sheet.measure, sheet.width, d) for d in given.get("diagrams", [])]
+        if diagrams:
+            body += [_diagrams_heading(sheet, diagrams[0]), *diagrams[1:]]
+        return _composed(sheet, drawing, [_title_block(sheet, given)], body, numbered=True)
+
+
+def assignment_sheet_from_given(given: Mapping[str, Any], position: int = 0) -> bytes:
+    """A variant's assignment sheet (A4 PDF), rendered from its ``given.json`` alone.
+
+    Page 1: the title, the variant and its folder, empty fields for the student's name, group and
+    date, and the mechanism rebuilt from ``given["scheme"]``
+    (:func:`~linkage.course.given.scheme_from_given`) drawn at the largest standard scale that
+    fits the rest of the page (:func:`assignment_sheet` says how); then the mechanism in words
+    (the template's description), the tasks, the parameters
+    of the variant and every section of ``given["data"]`` (quantity, symbol, value, unit: every
+    datum the answer key depends on), each load diagram of ``given["diagrams"]`` as a graph over
+    the stroke with its zones and its table of values (:func:`~linkage.course.diagram_blocks.diagram_block`)
+    after the loads, on as many pages as they need, numbered "page k of n".
+
+    Parameters
+    ----------
+    given : mapping
+        ``given.json`` as data (:func:`linkage.course.given.given_data`).
+    position : int
+        Index of the drawn position in the table (0: position 1).
+
+    Raises
+    ------
+    InputError
+        ``given`` holds no scheme, or a position outside the table.
+    SchemeError
+        Its scheme is invalid.
+    PlotExtraMissing
+        matplotlib is not installed.
+    """
+    pages = given_sheet_figures(given, position)
+    with page_style():
+        return pdf_bytes(pages, str(given.get("title") or "Assignment"))

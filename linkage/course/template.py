@@ -40,6 +40,7 @@ from __future__ import annotations
 import copy
 import csv
 import difflib
+import fnmatch
 import io
 import itertools
 import math
@@ -61,11 +62,14 @@ from .parameters import Parameter, is_plain_number, parse_parameters, value_type
 
 __all__ = [
     "DEFAULT_TASKS",
+    "Grading",
     "Template",
     "draws",
+    "given_rows",
     "given_variants",
     "load_template",
     "loads_template",
+    "quantity_names",
     "shipped_templates",
 ]
 
@@ -77,12 +81,70 @@ DEFAULT_TASKS = (
     "Size the flywheel for the given coefficient of speed fluctuation (Mertsalov's method)",
     "Find the law of motion of the input link: omega(phi) and epsilon(phi)",
 )
-TEMPLATE_KEYS = {"description", "tasks", "parameters", "require"}
+TEMPLATE_KEYS = {"description", "tasks", "parameters", "require", "grading"}
+GRADING_KEYS = {"tolerance", "digits", "points", "force_positions", "tolerances"}
+
+#: the quantities of an answer key (:mod:`~linkage.course.key`, docs/templates.md): ``P.<q>`` of a
+#: point P, ``L.<q>`` of a moving link L, ``K.<q>`` of a pair K, and the named ones
+POINT_QUANTITIES = ("x", "y", "x'", "y'", "x''", "y''", "vx", "vy", "v", "ax", "ay", "a")
+LINK_QUANTITIES = ("theta_deg", "theta'", "theta''", "omega", "eps")
+PAIR_QUANTITIES = ("R", "angle_deg")
+NAMED_QUANTITIES = (
+    "balancing_moment", "lever_balancing_moment",
+    "reduced_moment_resistance", "reduced_moment_driving", "reduced_inertia", "reduced_inertia_variable",
+    "reduced_inertia_derivative", "work_resistance", "work_driving", "delta_T", "T_variable", "delta_T_prime",
+    "omega", "eps",
+    "driving_moment", "delta_T_prime_max", "delta_T_prime_min", "delta_T_prime_swing", "reduced_inertia_constant",
+    "required_constant_inertia", "flywheel_inertia", "stroke",
+)
+#: characters that make a ``[template.grading] tolerances`` key a pattern
+_WILDCARDS = set("*?[")
 
 
 # ----------------------------------------------------------------------------------------------
 # the template
 # ----------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Grading:
+    """How an answer key grades a student's numbers: ``[template.grading]`` (docs/templates.md).
+
+    Attributes
+    ----------
+    tolerance : float
+        Relative tolerance of every quantity without its own (0.02: 2 %).
+    digits : int
+        Significant digits a student reports.
+    points : tuple of str or None
+        The points whose positions, analogs, velocities and accelerations the key holds; None: the
+        output point and the centres of mass of the moving links that are named points.
+    force_positions : tuple of int or None
+        Table positions (1 .. n+1) of the reactions and balancing moments; None: every position.
+    tolerances : dict of str -> float
+        Relative tolerance per quantity name (``"B.v"``) or pattern (``"*.R"``, shell-style).
+
+    >>> Grading(tolerances={"*.R": 0.05, "B.R": 0.01}).tolerance_of("A.R")
+    0.05
+    >>> Grading(tolerances={"*.R": 0.05, "B.R": 0.01}).tolerance_of("B.R"), Grading().tolerance_of("B.v")
+    (0.01, 0.02)
+    """
+
+    tolerance: float = 0.02
+    digits: int = 4
+    points: tuple[str, ...] | None = None
+    force_positions: tuple[int, ...] | None = None
+    tolerances: Mapping[str, float] = field(default_factory=dict)
+
+    def tolerance_of(self, quantity: str) -> float:
+        """The tolerance of ``quantity``: its own name in ``tolerances``, else the first pattern
+        there that matches it (in the order written), else ``tolerance``."""
+        if quantity in self.tolerances:
+            return self.tolerances[quantity]
+        for pattern, value in self.tolerances.items():
+            if _WILDCARDS & set(pattern) and fnmatch.fnmatchcase(quantity, pattern):
+                return value
+        return self.tolerance
 
 
 @dataclass(frozen=True)
@@ -107,6 +169,8 @@ class Template:
         ``[template.require]`` as written: feasibility rules another module checks.
     body : dict
         The scheme data without ``[template]``, expressions still as ``"= ..."`` strings.
+    grading : Grading
+        ``[template.grading]``: tolerances, digits and what the answer keys hold.
     """
 
     name: str
@@ -117,6 +181,7 @@ class Template:
     tasks: tuple[str, ...]
     require: dict
     body: dict
+    grading: Grading = field(default_factory=Grading)
     _derived: Mapping[str, Expression] = field(default_factory=dict, repr=False, compare=False)
     _order: tuple[str, ...] = field(default=(), repr=False, compare=False)
     _compiled: Mapping[str, Any] = field(default_factory=dict, repr=False, compare=False)
@@ -276,6 +341,119 @@ def _require(raw: Any, problems: list[str]) -> dict:
     return copy.deepcopy(dict(raw))
 
 
+def _scheme_names(body: Mapping[str, Any]) -> tuple[list[str], list[str], list[str]]:
+    """The point names, moving link names and pair names the template's scheme declares (a
+    link's ``line`` and ``points``; expressions and malformed entries left out)."""
+    links = body.get("links") if isinstance(body.get("links"), Mapping) else {}
+    points: set[str] = set()
+    for spec in links.values():
+        if not isinstance(spec, Mapping):
+            continue
+        line = spec.get("line") if isinstance(spec.get("line"), list) else []
+        table = spec.get("points") if isinstance(spec.get("points"), Mapping) else {}
+        points.update(p for p in [*line, *table] if isinstance(p, str) and not p.startswith("="))
+    frame = str(body.get("frame", "0"))
+    pairs = body.get("pairs") if isinstance(body.get("pairs"), Mapping) else {}
+    return sorted(points), sorted(str(k) for k in links if str(k) != frame), sorted(str(k) for k in pairs)
+
+
+def _table_rows(body: Mapping[str, Any]) -> int | None:
+    """The number of rows of the template's tables (positions + 1), when the scheme gives its
+    ``[dynamics] positions`` as a number (12 positions without ``[dynamics]``); None when an
+    expression gives it (checked per variant)."""
+    dynamics = body.get("dynamics")
+    if not isinstance(dynamics, Mapping) or "positions" not in dynamics:
+        return 13
+    n = dynamics["positions"]
+    return n + 1 if isinstance(n, int) and not isinstance(n, bool) and n >= 1 else None
+
+
+def _fraction(raw: Any, where: str, problems: list[str]) -> float | None:
+    if is_plain_number(raw) and math.isfinite(raw) and 0 < raw <= 1:
+        return float(raw)
+    problems.append(f"{where}: expected a relative tolerance, a number in (0, 1] (0.02 is 2 %), got {raw!r}")
+    return None
+
+
+def _distinct_list(raw: Any, where: str, what: str, problems: list[str]) -> list | None:
+    """A list of distinct entries, or None with a problem."""
+    if not isinstance(raw, list):
+        problems.append(f"{where}: expected a list of {what}, got {raw!r}")
+        return None
+    repeated = sorted({repr(x) for x in raw if raw.count(x) > 1})
+    if repeated:
+        problems.append(f"{where}: {', '.join(repeated)} listed more than once")
+    return raw
+
+
+def quantity_names(points, links, pairs) -> list[str]:
+    """Every quantity name an answer key of a scheme with these points, moving links and pairs may
+    hold (:data:`POINT_QUANTITIES` ... :data:`NAMED_QUANTITIES`)."""
+    return ([f"{p}.{q}" for p in points for q in POINT_QUANTITIES] + [f"{k}.{q}" for k in links for q in LINK_QUANTITIES]
+            + [f"{k}.{q}" for k in pairs for q in PAIR_QUANTITIES] + list(NAMED_QUANTITIES))
+
+
+def _grading(raw: Any, body: Mapping[str, Any], problems: list[str]) -> Grading:
+    """``[template.grading]`` read and checked against the template's scheme."""
+    if raw is None:
+        return Grading()
+    where = "[template.grading]"
+    if not isinstance(raw, Mapping):
+        problems.append(f"{where}: expected a table (tolerance, digits, points, force_positions, tolerances), "
+                        f"got {raw!r}")
+        return Grading()
+    unknown_keys(raw, GRADING_KEYS, where, problems)
+    points, links, pairs = _scheme_names(body)
+    found: dict[str, Any] = {}
+    if "tolerance" in raw:
+        found["tolerance"] = _fraction(raw["tolerance"], f"{where} tolerance", problems)
+    if "digits" in raw:
+        digits = raw["digits"]
+        if isinstance(digits, int) and not isinstance(digits, bool) and 1 <= digits <= 15:
+            found["digits"] = digits
+        else:
+            problems.append(f"{where} digits: expected a whole number of significant digits, 1 .. 15, got {digits!r}")
+    if "points" in raw:
+        names = _distinct_list(raw["points"], f"{where} points", "point names", problems)
+        for name in names or ():
+            if not isinstance(name, str) or name not in points:
+                problems.append(f"{where} points: {name!r} is not a point of the scheme"
+                                f"{_hint(str(name), points)}")
+        found["points"] = tuple(names) if names is not None else None
+    if "force_positions" in raw:
+        rows = _table_rows(body)
+        numbers = _distinct_list(raw["force_positions"], f"{where} force_positions", "table positions (whole numbers)",
+                         problems)
+        for k in numbers or ():
+            whole = isinstance(k, int) and not isinstance(k, bool)
+            if not whole or k < 1 or (rows is not None and k > rows):
+                span = f"1 .. {rows}: the scheme's {rows - 1} positions and position {rows}, the end of the cycle" \
+                    if rows is not None else "whole numbers from 1"
+                problems.append(f"{where} force_positions: {k!r} is not a table position ({span})")
+        found["force_positions"] = tuple(numbers) if numbers is not None else None
+    if "tolerances" in raw:
+        table = raw["tolerances"]
+        if not isinstance(table, Mapping):
+            problems.append(f"{where} tolerances: expected a table of quantity = relative tolerance "
+                            f"(\"B.v\" = 0.01, \"*.R\" = 0.05), got {table!r}")
+            table = {}
+        known = quantity_names(points, links, pairs)
+        tolerances = {}
+        for name, value in table.items():
+            if _WILDCARDS & set(name):
+                if not any(fnmatch.fnmatchcase(q, name) for q in known):
+                    problems.append(f"{where} tolerances: the pattern {name!r} matches no quantity of the key")
+            elif name not in known:
+                meant = difflib.get_close_matches(name, known, n=1)
+                hint = f"; did you mean {meant[0]!r}?" if meant else " (docs/templates.md lists the quantities)"
+                problems.append(f"{where} tolerances: {name!r} is not a quantity of the key{hint}")
+            tolerance = _fraction(value, f"{where} tolerances {name!r}", problems)
+            if tolerance is not None:
+                tolerances[name] = tolerance
+        found["tolerances"] = tolerances
+    return Grading(**{k: v for k, v in found.items() if v is not None})
+
+
 def _text(raw: Any, where: str, problems: list[str]) -> str:
     if raw is None:
         return ""
@@ -293,6 +471,7 @@ def _template_from_data(data: Mapping[str, Any], source: str, default_name: str)
     parameters, derived, order, types = parse_parameters(table.get("parameters"), problems)
     tasks = _tasks(table.get("tasks"), problems)
     require = _require(table.get("require"), problems)
+    grading = _grading(table.get("grading"), body, problems)
     description = _text(table.get("description"), "[template] description", problems) \
         or _text(body.get("description"), "description", problems)
     name = _text(body.get("name"), "name", problems) or default_name
@@ -300,7 +479,7 @@ def _template_from_data(data: Mapping[str, Any], source: str, default_name: str)
     if problems:
         raise SchemeError([f"{source}: {p}" for p in problems])
     return Template(name, description, source, parameters, tuple(p.name for p in parameters if p.free), tasks,
-                    require, body, derived, order, compiled)
+                    require, body, grading, derived, order, compiled)
 
 
 def loads_template(text: str, source: str = "<string>") -> Template:
@@ -451,7 +630,14 @@ def _read_rows(path: Path) -> tuple[list[tuple[int, list[str]]], str]:
 
 
 def given_variants(template: Template, csv_path: str | Path) -> list[tuple[str, dict[str, Any]]]:
-    """The variants of a teacher's table: ``[(label, free values), ...]`` in the file's order.
+    """The variants of a teacher's table: ``[(label, free values), ...]`` in the file's order
+    (:func:`given_rows` without the lines)."""
+    return [(label, values) for _, label, values in given_rows(template, csv_path)]
+
+
+def given_rows(template: Template, csv_path: str | Path) -> list[tuple[int, str, dict[str, Any]]]:
+    """The variants of a teacher's table: ``[(line, label, free values), ...]`` in the file's
+    order, ``line`` the row's line number in the file (1: the header).
 
     The CSV has a header with one column per free parameter and optionally ``variant`` (the
     label; default ``"1"``, ``"2"``, ...). Delimiter ``,`` (or ``;`` or tab, then a decimal
@@ -469,7 +655,7 @@ def given_variants(template: Template, csv_path: str | Path) -> list[tuple[str, 
     (_, header), data = rows[0], rows[1:]
     names, label_column = _csv_header(header, template, str(path))
     problems: list[str] = []
-    variants: list[tuple[str, dict[str, Any]]] = []
+    variants: list[tuple[int, str, dict[str, Any]]] = []
     seen: dict[str, int] = {}
     for count, (line, cells) in enumerate(data, start=1):
         where = f"{path}: line {line}"
@@ -486,7 +672,7 @@ def given_variants(template: Template, csv_path: str | Path) -> list[tuple[str, 
         if not found:
             found += _derived_problems(template, values, where)
         problems += found
-        variants.append((label, values))
+        variants.append((line, label, values))
     if not data:
         problems.append(f"{path}: no variants: only a header")
     if problems:

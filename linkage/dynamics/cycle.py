@@ -93,6 +93,13 @@ class LawOfMotion:
         return self.constant_inertia + self.reduced.inertia_variable
 
     @property
+    def driving(self) -> np.ndarray:
+        """The driving moment at the table positions, N m: the constant ``driving_moment`` (course,
+        exact), the motor's moment at each position's speed (ode, ``details["motor_moment"]``)."""
+        motor = self.details.get("motor_moment")
+        return np.full(len(self.phi), float(self.driving_moment)) if motor is None else np.asarray(motor, float)
+
+    @property
     def mean_speed_actual(self) -> float:
         return float(np.sign(self.omega[0]) * (np.max(np.abs(self.omega)) + np.min(np.abs(self.omega))) / 2)
 

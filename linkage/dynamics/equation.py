@@ -483,4 +483,5 @@ def steady_state(mech: Mechanism, spec: DynamicsSpec | None = None, *, constant_
     return LawOfMotion("ode", phi, red, cycle_mean, float(constant), flywheel if flywheel > 0 else None,
                        speed_fluctuation(w_fine, mean), float(constant),
                        spec.rotation * w, angular_acceleration(red, driving_table, inertia, w),
-                       {"mean_speed": float(spec.rotation * mean), "period": float(sol.y[1][-1])})
+                       {"mean_speed": float(spec.rotation * mean), "period": float(sol.y[1][-1]),
+                        "motor_moment": np.broadcast_to(np.asarray(driving_table, float), w.shape).copy()})

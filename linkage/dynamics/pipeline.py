@@ -61,8 +61,10 @@ class DynamicsReport:
 
     def columns(self) -> dict[str, np.ndarray]:
         """Per position: ``i`` (from 1), ``phi_deg`` (the crank angle travelled from the cycle's
-        start in the direction of rotation, deg: 0 .. 360), ``reduced_moment_resistance`` and
-        ``reduced_moment_driving`` (N m, positive when they drive), ``reduced_inertia`` (kg m^2,
+        start in the direction of rotation, deg: 0 .. 360), ``reduced_moment_resistance`` (M_c)
+        and ``reduced_moment_driving`` (N m, positive when they drive: the method's driving moment
+        M_d -- the constant that balances the cycle (course, exact) or the motor's moment at the
+        position's speed (ode) -- plus the loads declared as driving), ``reduced_inertia`` (kg m^2,
         the machine as declared: ``I_0 + I''``, without a flywheel the method adds),
         ``reduced_inertia_derivative`` (dI/dpsi, kg m^2/rad), ``omega`` (rad/s, signed), ``eps``
         (rad/s^2), ``balancing_moment`` (N m, under that motion)."""
@@ -71,7 +73,7 @@ class DynamicsReport:
             "i": np.arange(1, len(self.law.phi) + 1),
             "phi_deg": table_positions_deg(self.law.phi),
             "reduced_moment_resistance": red.moment_resistance,
-            "reduced_moment_driving": red.moment_driving,
+            "reduced_moment_driving": red.moment_driving + self.law.driving,
             "reduced_inertia": red.inertia,
             "reduced_inertia_derivative": red.inertia_derivative,
             "omega": self.law.omega,
@@ -137,7 +139,8 @@ def run_dynamics(mech: Mechanism, method: str = "course", *, positions: int | No
             comparison = {
                 "exact_required_constant_inertia": exact.required_constant_inertia,
                 "exact_flywheel_inertia": exact.flywheel_inertia,
-                "course_vs_exact_inertia": law.required_constant_inertia / exact.required_constant_inertia - 1,
+                "course_vs_exact_inertia": (law.required_constant_inertia / exact.required_constant_inertia - 1
+                                            if exact.required_constant_inertia > 0 else None),
                 "course_delta_exact": _course_delta_exactly(spec, law, exact),
             }
     elif method == "exact":

@@ -195,7 +195,10 @@ class Motion:
         rotation); per point ``P.x P.y P.x' P.y' P.x'' P.y''``; per moving link
         ``L.theta L.theta' L.theta''`` (``L.theta`` the link's absolute angle, CCW from +x, rad, in
         (-pi, pi]; for the input link it is the absolute input angle phi); per prismatic pair
-        ``K.s K.s' K.s''``. SI units: m, rad; ``'`` and ``''`` are d/dphi and d2/dphi2.
+        ``K.s K.s' K.s''``. SI units: m, rad; ``'`` and ``''`` are d/dphi and d2/dphi2 of the
+        absolute input angle. The tables for people (``linkage analyze``, the report folder, the
+        course keys) give the first analogs per rad turned instead, d/dpsi = ``direction`` d/dphi
+        (:func:`linkage.report.tables.per_turned_angle`; docs/conventions.md).
 
         Parameters
         ----------

@@ -1,6 +1,11 @@
 """Diagrams of table columns against the input: the quantity and its unit in words on every axis.
 
-The x axis is ``phi_deg``, the input angle turned from position 1 (``s``, m, for a slide input).
+The x axis is ``phi_deg``, psi, the input angle turned from position 1 in the direction of rotation
+(``s``, m, for a slide input), and analogs are drawn as derivatives with respect to it, d/dpsi
+(d/ds): a curve and its analog agree by graphical differentiation whichever way the crank turns.
+The Python API's ``Motion.columns()`` gives d/dphi of the absolute angle; :func:`plot_motion`
+turns them into d/dpsi itself, :func:`plot_columns` and :func:`plot_diagrams` with their
+``direction`` (docs/conventions.md).
 
 - :func:`plot_columns` -- table columns of one unit on one set of axes: axes labelled with the
   quantity in words and its unit, legends in words
@@ -37,7 +42,7 @@ from ..kinematics.extremes import extreme_positions
 from ..kinematics.motion import analyze
 from ..model.mechanism import Mechanism
 from .style import CURVE_COLOURS, FONT, MARKERS, PAGE_WIDTH, SMALL, new_figure, pyplot
-from .tables import column_unit
+from .tables import column_unit, per_turned_angle
 from .words import ColumnWords, describe_column
 
 __all__ = ["extreme_marks", "plot_columns", "plot_diagrams", "plot_motion", "plot_dynamics", "style_angle_axis",
@@ -54,7 +59,7 @@ def _panel_label(described: Sequence[ColumnWords]) -> str:
     if len(described) == 1:
         return described[0].axis
     kinds = list(dict.fromkeys(d.kind for d in described))
-    symbols = ", ".join(d.symbol for d in described if d.symbol)
+    symbols = ", ".join(d.short for d in described if d.short)     # an analog: its derivative
     text = f"{' and '.join(kinds)} {symbols}".strip()
     unit = described[0].unit
     return f"{text}, {unit}" if unit else text
@@ -172,18 +177,23 @@ def number_positions(ax, phi: np.ndarray, numbers: np.ndarray) -> None:
 def plot_columns(columns: Mapping[str, Any], names: Sequence[str], ax=None, *,
                  mechanism: Mechanism | None = None, fine: Mapping[str, Any] | None = None,
                  marks: Iterable[tuple[float, str]] = (), mean_moment: float | None = None,
-                 mean_label: str | None = None, numbers: bool = True, legend: bool | None = None):
-    """Plot table columns of one unit against the input angle ``phi_deg``.
+                 mean_label: str | None = None, numbers: bool = True, legend: bool | None = None,
+                 direction: int = 1):
+    """Plot table columns of one unit against the input angle turned, ``phi_deg``.
 
     The y axis is labelled with the quantity in words and its unit, the legend names the curves
     in words (:func:`~linkage.report.words.describe_column`); every table position is marked on
-    each curve and numbered along the top; angle columns are drawn continuous.
+    each curve and numbered along the top; angle columns are drawn continuous. Analogs are drawn
+    with respect to the x axis, d/dpsi (psi = ``phi_deg`` in rad; d/ds for a slide input), so
+    that each is the slope of its quantity's curve.
 
     Parameters
     ----------
     columns : mapping of str -> array
-        A table with ``phi_deg`` and, for the numbers, ``i`` (``Motion.columns()``,
-        ``Reactions.columns()``, ``DynamicsReport.columns()``).
+        A table with ``phi_deg`` and, for the numbers, ``i``: a table for people
+        (:func:`~linkage.report.results.kinematics_results`, analogs d/dpsi), ``Motion.columns()``
+        (analogs d/dphi: give ``direction``), ``Reactions.columns()``,
+        ``DynamicsReport.columns()``.
     names : sequence of str
         The columns to plot; all of one unit (:func:`plot_diagrams` puts columns of several units
         on panels of their own).
@@ -206,6 +216,12 @@ def plot_columns(columns: Mapping[str, Any], names: Sequence[str], ax=None, *,
         Number the table positions along the top of the axes.
     legend : bool, optional
         Draw a legend (default: when there is more than one entry).
+    direction : {1, -1}
+        For columns of the Python API (``Motion.columns()``, whose first analogs are d/dphi of
+        the absolute input angle): the sense of rotation of their table, ``motion.direction``
+        (-1 clockwise); their first analogs (and those of ``fine``) are drawn multiplied by it,
+        d/dpsi (:func:`~linkage.report.tables.per_turned_angle`). 1 (default): drawn as given,
+        for a table for people, whose analogs are d/dpsi already (or a counter-clockwise one).
 
     Returns
     -------
@@ -228,7 +244,7 @@ def plot_columns(columns: Mapping[str, Any], names: Sequence[str], ax=None, *,
     >>> motion = linkage.analyze(mech, linkage.table_angles(mech, 12))
     >>> ax = plot_columns(motion.columns(), ["3.theta'"], mechanism=mech)
     >>> ax.get_ylabel().replace("\\n", " ")
-    "angular velocity analog of rocker 3 $\\\\theta'_{\\\\mathrm{3}}$, rad/rad"
+    "angular velocity analog of rocker 3 $d\\\\theta_{\\\\mathrm{3}}/d\\\\psi$, rad/rad"
     >>> ax.figure.savefig(io.BytesIO(), format="svg")
     >>> matplotlib.pyplot.close(ax.figure)
     """
@@ -247,6 +263,9 @@ def plot_columns(columns: Mapping[str, Any], names: Sequence[str], ax=None, *,
     if len(units) > 1:
         raise InputError(f"columns {names} have different units ({', '.join(str(u) for u in units)}): "
                          "plot them with plot_diagrams, one panel per unit")
+    if direction != 1:
+        columns = per_turned_angle(columns, direction)
+        fine = None if fine is None else per_turned_angle(fine, direction)
     if ax is None:
         ax = new_figure(PAGE_WIDTH, 3.8).add_subplot()
     phi = np.asarray(columns[position], dtype=float)
@@ -361,7 +380,7 @@ def finish_panels(axes) -> None:
 
 def plot_diagrams(columns: Mapping[str, Any], names: Sequence[str], *, mechanism: Mechanism | None = None,
                   fine: Mapping[str, Any] | None = None, marks: Iterable[tuple[float, str]] = (),
-                  mean_moment: float | None = None, mean_label: str | None = None):
+                  mean_moment: float | None = None, mean_label: str | None = None, direction: int = 1):
     """Diagrams of table columns, one panel per unit, over a shared input-angle axis.
 
     Columns of one unit share a panel (in the order of ``names``); the panels are drawn by
@@ -370,8 +389,9 @@ def plot_diagrams(columns: Mapping[str, Any], names: Sequence[str], *, mechanism
 
     Parameters
     ----------
-    columns, names, mechanism, fine, marks, mean_moment, mean_label
-        As in :func:`plot_columns`.
+    columns, names, mechanism, fine, marks, mean_moment, mean_label, direction
+        As in :func:`plot_columns` (``direction``: the sense of rotation of ``Motion.columns()``,
+        whose analogs are d/dphi, so that they are drawn d/dpsi; 1 for a table for people).
 
     Returns
     -------
@@ -384,7 +404,7 @@ def plot_diagrams(columns: Mapping[str, Any], names: Sequence[str], *, mechanism
     >>> import io, linkage
     >>> mech = linkage.load("slider_crank")
     >>> motion = linkage.analyze(mech, linkage.table_angles(mech, 12))
-    >>> fig = plot_diagrams(motion.columns(), ["B.x", "B.x'", "B.x''"], mechanism=mech)
+    >>> fig = plot_diagrams(motion.columns(), ["B.x", "B.x'", "B.x''"], mechanism=mech, direction=motion.direction)
     >>> [ax.get_ylabel().split("$")[0].strip() for ax in fig.axes if ax.get_ylabel()]
     ['slider position', 'slider velocity analog', 'slider acceleration analog']
     >>> fig.savefig(io.BytesIO(), format="png")
@@ -402,7 +422,7 @@ def plot_diagrams(columns: Mapping[str, Any], names: Sequence[str], *, mechanism
     for k, (ax, group) in enumerate(zip(axes, groups)):
         moment = mean_moment if column_unit(group[0]) == "N m" else None
         plot_columns(columns, group, ax, mechanism=mechanism, fine=fine, marks=marks, mean_moment=moment,
-                     mean_label=mean_label, numbers=k == 0, legend=False)
+                     mean_label=mean_label, numbers=k == 0, legend=False, direction=direction)
     finish_panels(axes)
     if any(len(ax.get_legend_handles_labels()[1]) > 1 for ax in axes):
         figure_legend(fig, axes)
@@ -421,7 +441,10 @@ def plot_motion(motion, names: Sequence[str], *, extremes: bool | str = True, po
     """Kinematic diagrams of a motion analysed at table positions.
 
     Smooth curves from an analysis on a finer grid (``points`` angles over the table), the table
-    rows marked and numbered, the extreme positions of the output marked.
+    rows marked and numbered, the extreme positions of the output marked. The x axis is the angle
+    turned from position 1 in the direction of rotation, psi (``phi_deg``), and the analogs are
+    drawn d/dpsi = ``motion.direction`` d/dphi (d/ds for a slide input), the slopes of their
+    quantities' curves whichever way the crank turns.
 
     Parameters
     ----------
@@ -454,8 +477,9 @@ def plot_motion(motion, names: Sequence[str], *, extremes: bool | str = True, po
 
     pyplot()
     mech = motion.mechanism
-    columns = motion.columns()
     direction = motion.direction
+    sense = direction if mech.coordinate.is_angle else 1    # a slide input: its analogs are per m of s
+    columns = motion.columns()
     order = 2 if motion.second is not None else 1 if motion.first is not None else 0
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -465,7 +489,7 @@ def plot_motion(motion, names: Sequence[str], *, extremes: bool | str = True, po
     marks: list[tuple[float, str]] = []
     if extremes and (isinstance(extremes, str) or mech.output is not None) and len(motion.phi) > 1:
         marks = extreme_marks(mech, motion.phi, extremes if isinstance(extremes, str) else None)
-    return plot_diagrams(columns, names, mechanism=mech, fine=fine, marks=marks)
+    return plot_diagrams(columns, names, mechanism=mech, fine=fine, marks=marks, direction=sense)
 
 
 def plot_dynamics(report, names: Sequence[str] = ("balancing_moment",), *, extremes: bool = True):

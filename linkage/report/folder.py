@@ -195,7 +195,9 @@ class _Work:
             self.report.notes.append("kinematic diagrams: left out (the scheme declares no output)")
             return
         q = output.quantity
-        self._picture("kinematic_diagrams", f"Kinematic diagrams of the output {q}: position and analogs",
+        per = ("per rad of crank rotation, d/dψ" if self.mech.coordinate.is_angle
+               else "per m of the input's slide, d/ds")
+        self._picture("kinematic_diagrams", f"Kinematic diagrams of the output {q}: position and analogs ({per})",
                       lambda: plot_motion(self.kinematics.motion, [q, q + "'", q + "''"]))
 
     def force_pictures(self) -> None:
@@ -291,9 +293,19 @@ class _Work:
             name=mech.name, description=mech.description, formula=structure_of(mech).formula,
             links=_links(mech), pairs=_pairs(mech), scheme_text=dumps(mech), summary=summary,
             pictures=self.report.pictures, animation="animation.gif" if "animation.gif" in files else None,
-            tables=tables, notes=self.report.notes, version=__version__,
+            tables=tables, notes=self.report.notes, version=__version__, analogs=_analogs_words(mech),
             kinematics_units=units_of(self.kinematics.columns) if self.kinematics else {})
         self._write("index.html", html)
+
+
+def _analogs_words(mech: Mechanism) -> str:
+    """What the analog columns of kinematics.csv are per, for the page (docs/conventions.md)."""
+    if not mech.coordinate.is_angle:
+        return ("In kinematics.csv the analogs (the columns ending in ' and '') are per m of the input's "
+                "slide s, d/ds.")
+    return ("In kinematics.csv the analogs (the columns ending in ' and '') are per rad of crank rotation, "
+            "d/dψ and d²/dψ²: ψ is phi_deg in rad, the angle turned from position 1 in the direction of "
+            "rotation, so each analog is the slope of its quantity's curve.")
 
 
 #: the scalar results of ``linkage dynamics`` on the page: key -> (words, unit)

@@ -28,11 +28,11 @@ from ..kinetostatics.reactions import solve_reactions, virtual_power_residual
 from ..model.mechanism import Mechanism
 from ..model.scheme import section_of
 from ..structure import structure_of
-from .tables import format_columns, units_of
+from .tables import format_columns, per_turned_angle, units_of
 
-__all__ = ["JSON_CONVENTIONS", "DynamicsResults", "InputRange", "TableResults", "declared_rotation",
-           "dynamics_results", "failures", "forces_results", "json_document", "kinematics_results",
-           "table_positions"]
+__all__ = ["ANALOGS_PER_TURNED", "ANALOGS_PER_SLIDE", "JSON_CONVENTIONS", "DynamicsResults", "InputRange",
+           "TableResults", "analog_direction", "declared_rotation", "dynamics_results", "failures",
+           "forces_results", "json_document", "kinematics_results", "table_positions"]
 
 #: the ``conventions`` entry of every JSON document the command line writes
 JSON_CONVENTIONS = "see `linkage --help` and docs/conventions.md"
@@ -183,6 +183,22 @@ def table_sense(phi: np.ndarray) -> int:
     return -1 if len(phi) > 1 and phi[-1] < phi[0] else 1
 
 
+def analog_direction(mech: Mechanism, phi: np.ndarray) -> int:
+    """The factor that turns a table's first analogs d/dphi (the Python API's) into the analogs
+    for people, d/dpsi (:func:`~linkage.report.tables.per_turned_angle`): the sense of the table
+    (:func:`table_sense`) for a crank, whose psi is the angle turned from position 1 (the
+    ``phi_deg`` column, in rad); +1 for a slide input, whose analogs are per m of the slide ``s``
+    itself (a coordinate has no sense of rotation)."""
+    return table_sense(phi) if mech.coordinate.is_angle else 1
+
+
+#: the ``analogs`` entry of the JSON document of ``linkage analyze`` for a crank (docs/conventions.md)
+ANALOGS_PER_TURNED = ("d/dpsi: per rad turned in the direction of rotation from position 1 "
+                      "(psi = phi_deg in rad; the Python API's Motion gives d/dphi)")
+#: the same for a slide input: its analogs are per m of the slide ``s``
+ANALOGS_PER_SLIDE = "d/ds: per m of the input's slide s (the position column)"
+
+
 def failures(motion: Motion) -> tuple[list[dict], list[str]]:
     """The positions of ``motion`` that cannot be assembled, are singular or where Newton's method
     did not converge (a group solved by it, docs/groups.md): one JSON entry per
@@ -238,7 +254,13 @@ def _caught(caught, failed) -> list[str]:
 def kinematics_results(mech: Mechanism, positions: int | None = None,
                        start: str | float | InputRange | None = None) -> TableResults:
     """The table of ``linkage analyze``: positions and analogs at the scheme's table positions
-    (``positions`` and ``start`` as the command's options)."""
+    (``positions`` and ``start`` as the command's options).
+
+    The table is for people: its first analogs are taken with respect to the angle turned, psi
+    (``phi_deg`` in rad), ``B.x' = dx_B/dpsi = direction * dx_B/dphi`` (:func:`analog_direction`,
+    :func:`~linkage.report.tables.per_turned_angle`); second analogs are the same either way.
+    ``motion`` (the :class:`~linkage.kinematics.motion.Motion`) keeps d/dphi; the JSON metadata
+    says so under ``analogs``."""
     direction = declared_rotation(mech)
     n, start = table_defaults(mech, positions, start)
     notes: list[str] = []
@@ -246,10 +268,11 @@ def kinematics_results(mech: Mechanism, positions: int | None = None,
         warnings.simplefilter("always")
         phi, start = table_positions(mech, n, start, direction, notes)
         motion = analyze(mech, phi, order=2, on_failure="mask")
-        columns = motion.columns()
+        columns = per_turned_angle(motion.columns(), analog_direction(mech, phi))
     failed, lines = failures(motion)
     meta = {"scheme": mech.name, "description": mech.description, "formula": structure_of(mech).formula,
             "positions": n, "start": start, **start_meta(mech, phi), "direction": table_sense(phi),
+            "analogs": ANALOGS_PER_TURNED if mech.coordinate.is_angle else ANALOGS_PER_SLIDE,
             "failed": failed}
     return TableResults(columns, meta, motion, notes, lines + _caught(caught, failed))
 

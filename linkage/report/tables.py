@@ -44,7 +44,7 @@ import numpy as np
 
 from ..errors import InputError
 
-__all__ = ["FORMATS", "format_columns", "column_unit", "units_of", "select_columns", "table_width"]
+__all__ = ["FORMATS", "format_columns", "column_unit", "units_of", "select_columns", "table_width", "per_turned_angle"]
 
 #: the output formats understood by :func:`format_columns`
 FORMATS = ("table", "csv", "json")
@@ -221,6 +221,27 @@ _QUANTITY_UNITS = {
     "R": ("N",), "Rx": ("N",), "Ry": ("N",),  # pair reaction: magnitude, components
     "M": ("N m",),                         # moment in a prismatic pair
 }
+
+
+def per_turned_angle(columns: Mapping[str, Any], direction: int) -> dict[str, Any]:
+    """The columns with their analogs taken with respect to the angle turned, for people.
+
+    Tables, keys, diagrams and sheets run over psi, the input angle turned from position 1 in the
+    direction of rotation (``direction``: +1 counter-clockwise, -1 clockwise; +1 for a slide
+    input), so that a curve and its derivative agree by graphical differentiation whatever the
+    sense. With ``phi = phi_1 + direction * psi``: ``dq/dpsi = direction * dq/dphi`` and
+    ``d2q/dpsi2 = d2q/dphi2``. The first analogs (names ending in exactly one ``'``) are
+    multiplied by ``direction``; every other column is kept as it is (the Python API's
+    :class:`~linkage.kinematics.motion.Motion` keeps d/dphi).
+
+    >>> import numpy as np
+    >>> per_turned_angle({"B.x": np.array([0.3]), "B.x'": np.array([0.1]), "B.x''": np.array([-2.0])}, -1)
+    {'B.x': array([0.3]), "B.x'": array([-0.1]), "B.x''": array([-2.])}
+    """
+    if direction not in (1, -1):
+        raise ValueError(f"direction must be +1 or -1, got {direction!r}")
+    return {name: (direction * np.asarray(values) if name.endswith("'") and not name.endswith("''") else values)
+            for name, values in columns.items()}
 
 
 def column_unit(name: str, per: str = "rad") -> str | None:

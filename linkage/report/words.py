@@ -54,7 +54,12 @@ class ColumnWords:
         The family it belongs to, plural (``"velocity analogs"``): the axis label of a panel that
         holds several columns.
     note : str
-        A sign convention the legend adds after the unit (``"CCW positive"``), or ``""``.
+        A convention the legend adds after the unit (``"CCW positive"``; for an analog what it is
+        per, ``"per rad of crank rotation"``), or ``""``.
+    derivative : str
+        An analog written as the derivative it is, in mathtext (``"$dx_{B}/d\\psi$"``: with
+        respect to psi, the input angle turned from position 1 in the direction of rotation, the
+        diagrams' x axis; ``/ds`` for a slide input), or ``""`` for any other column.
     """
 
     name: str
@@ -63,17 +68,33 @@ class ColumnWords:
     unit: str | None
     kind: str
     note: str = ""
+    derivative: str = ""
+
+    @property
+    def defined(self) -> str:
+        """The symbol, with the derivative it stands for when it is an analog
+        (``"$x'_{B} = dx_{B}/d\\psi$"``)."""
+        if self.derivative and self.symbol:
+            return f"{self.symbol[:-1]} = {self.derivative[1:]}"
+        return self.symbol or self.derivative
+
+    @property
+    def short(self) -> str:
+        """The symbol of an axis label: the derivative of an analog, else the symbol."""
+        return self.derivative or self.symbol
 
     @property
     def axis(self) -> str:
-        """Axis label: words, symbol and unit (``"slider position $x_{B}$, m"``)."""
-        text = f"{self.words} {self.symbol}".strip()
+        """Axis label: words, symbol (an analog's derivative) and unit (``"slider position $x_{B}$, m"``,
+        ``"slider velocity analog $dx_{B}/d\\psi$, m/rad"``)."""
+        text = f"{self.words} {self.short}".strip()
         return f"{text}, {self.unit}" if self.unit else text
 
     @property
     def legend(self) -> str:
-        """Legend entry: words, symbol and unit (``"velocity analog of B along x $x'_{B}$ (m/rad)"``)."""
-        text = f"{self.words} {self.symbol}".strip()
+        """Legend entry: words, symbol and unit (``"velocity analog of B along x $x'_{B} = dx_{B}/d\\psi$
+        (m/rad, per rad of crank rotation)"``)."""
+        text = f"{self.words} {self.defined}".strip()
         extra = ", ".join(x for x in (self.unit, self.note) if x)
         return f"{text} ({extra})" if extra else text
 
@@ -137,7 +158,7 @@ _ORDER_WORDS = ("", "velocity analog", "acceleration analog")
 #: whole-name columns: words, symbol, family ({crank} is the input link's role)
 _NAMED = {
     "i": ("position number", "$i$", "position numbers"),
-    "phi_deg": ("{crank} angle from the start", r"$\varphi$", "angles"),
+    "phi_deg": ("{crank} angle turned from position 1", r"$\psi$", "angles"),
     "s": ("slide of the {crank}", "$s$", "slides"),
     "balancing_force": ("balancing force on the {crank}", "$F_b$", "forces"),
     "v": ("speed of the {crank}", "$v$", "speeds"),
@@ -189,9 +210,9 @@ def describe_column(name: str, mechanism: Mechanism | None = None) -> ColumnWord
     >>> describe_column("B.x", mech).axis
     'slider position $x_{\\\\mathrm{B}}$, m'
     >>> describe_column("B.x'").legend
-    "velocity analog of B along x $x'_{\\\\mathrm{B}}$ (m/rad)"
+    "velocity analog of B along x $x'_{\\\\mathrm{B}} = dx_{\\\\mathrm{B}}/d\\\\psi$ (m/rad, per rad of crank rotation)"
     >>> describe_column("phi_deg", mech).axis
-    'crank angle from the start $\\\\varphi$, deg'
+    'crank angle turned from position 1 $\\\\psi$, deg'
     >>> describe_column("3.theta", linkage.load("four_bar")).words
     'angle of rocker 3'
     """
@@ -216,6 +237,7 @@ def describe_column(name: str, mechanism: Mechanism | None = None) -> ColumnWord
     if not dot or order > 2:
         return ColumnWords(name, name, "", unit, name)
     sub, prime = subscript(obj), _PRIMES[order]
+    per_input = _per_input(mechanism, order, ("\\theta" if base == "theta" else base) + "_" + sub)
     if base in ("x", "y"):
         axis = "xy".index(base)
         symbol = f"${base}{prime}_{sub}$"
@@ -224,16 +246,16 @@ def describe_column(name: str, mechanism: Mechanism | None = None) -> ColumnWord
         else:
             words = f"{base} coordinate of {obj}" if order == 0 else f"{_ORDER_WORDS[order]} of {obj} along {base}"
         kind = ("coordinates", "velocity analogs", "acceleration analogs")[order]
-        return ColumnWords(name, words, symbol, unit, kind)
+        return ColumnWords(name, words, symbol, unit, kind, *per_input)
     if base == "theta":
         role = link_role(mechanism, obj) if mechanism is not None and obj in mechanism.links else "link"
         what = ("angle", "angular velocity analog", "angular acceleration analog")[order]
         kind = ("link angles", "angular velocity analogs", "angular acceleration analogs")[order]
-        return ColumnWords(name, f"{what} of {role} {obj}", f"$\\theta{prime}_{sub}$", unit, kind)
+        return ColumnWords(name, f"{what} of {role} {obj}", f"$\\theta{prime}_{sub}$", unit, kind, *per_input)
     if base == "s":
         words = "slide in pair " + obj if order == 0 else f"{_ORDER_WORDS[order]} of the slide in pair {obj}"
         kind = ("slides", "velocity analogs", "acceleration analogs")[order]
-        return ColumnWords(name, words, f"$s{prime}_{sub}$", unit, kind)
+        return ColumnWords(name, words, f"$s{prime}_{sub}$", unit, kind, *per_input)
     if order == 0 and base in ("R", "Rx", "Ry"):
         words = {"R": f"reaction in pair {obj}", "Rx": f"x component of the reaction in pair {obj}",
                  "Ry": f"y component of the reaction in pair {obj}"}[base]
@@ -245,6 +267,23 @@ def describe_column(name: str, mechanism: Mechanism | None = None) -> ColumnWord
     if order == 0 and base == "M":
         return ColumnWords(name, f"moment in pair {obj}", f"$M_{sub}$", unit, "moments", "CCW positive")
     return ColumnWords(name, name, "", unit, name)
+
+
+def _per_input(mechanism: Mechanism | None, order: int, quantity: str) -> tuple[str, str]:
+    """What an analog of order 1 or 2 is per, in words, and the analog as a derivative in
+    mathtext: with respect to psi, the angle turned from position 1 in the direction of rotation
+    (``"per rad of crank rotation"``, ``"$dx_{B}/d\\psi$"``), or to the slide s of a slide input
+    (``"per m of cylinder travel"``, ``"$dx_{B}/ds$"``); ``("", "")`` for order 0."""
+    if not order:
+        return "", ""
+    crank = input_word(mechanism)
+    slide = mechanism is not None and bool(mechanism.inputs) and not mechanism.coordinate.is_angle
+    unit, what, var = ("m", "travel", "s") if slide else ("rad", "rotation", "\\psi")
+    power = "²" if order == 2 else ""
+    note = f"per {unit}{power} of {crank} {what}"
+    if order == 1:
+        return note, f"$d{quantity}/d{var}$"
+    return note, f"$d^2{quantity}/d{var}^2$"
 
 
 # ----------------------------------------------------------------------------------------------
