@@ -8,6 +8,8 @@ sheets and answer keys (:mod:`~.variants`); what a student is given, machine-rea
 (:mod:`~.given`, ``given.json``); the printable PDFs: one variant's assignment sheet rendered from
 it, with the mechanism drawn to scale (:mod:`~.sheets`) and the load diagrams
 (:mod:`~.diagram_blocks`), the overview of all variants
-(:mod:`~.overview`), and the page toolkit both are typeset with (:mod:`~.typesetting`). Reads the
-model, the kinematics' feasibility rules and the report's tables, results and drawings.
+(:mod:`~.overview`), and the page toolkit both are typeset with (:mod:`~.typesetting`); the
+step-by-step answer key (:mod:`~.key`, ``key.json`` and ``key.csv``) and the grading of a class's
+answers against it (:mod:`~.grading`, ``linkage grade``). Reads the model, the kinematics'
+feasibility rules, the kinetostatics, the dynamics and the report's tables, results and drawings.
 """

@@ -79,7 +79,7 @@ DEFAULT_TASKS = (
     "Kinematic analysis: positions, velocities and accelerations of the output at the table positions",
     "Kinetostatic analysis: the reactions in the kinematic pairs and the balancing moment",
     "Size the flywheel for the given coefficient of speed fluctuation (Mertsalov's method)",
-    "Find the law of motion of the input link: omega(phi) and epsilon(phi)",
+    "Find the law of motion of the input link: ω(φ) and ε(φ)",
 )
 TEMPLATE_KEYS = {"description", "tasks", "parameters", "require", "grading"}
 GRADING_KEYS = {"tolerance", "digits", "points", "force_positions", "tolerances"}

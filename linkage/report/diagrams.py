@@ -242,9 +242,9 @@ def plot_columns(columns: Mapping[str, Any], names: Sequence[str], ax=None, *,
     >>> import io, linkage
     >>> mech = linkage.load("four_bar")
     >>> motion = linkage.analyze(mech, linkage.table_angles(mech, 12))
-    >>> ax = plot_columns(motion.columns(), ["3.theta'"], mechanism=mech)
+    >>> ax = plot_columns(motion.columns(), ["3.theta'"], mechanism=mech, direction=motion.direction)
     >>> ax.get_ylabel().replace("\\n", " ")
-    "angular velocity analog of rocker 3 $d\\\\theta_{\\\\mathrm{3}}/d\\\\psi$, rad/rad"
+    'angular velocity analog of rocker 3 $d\\\\theta_{\\\\mathrm{3}}/d\\\\psi$, rad/rad'
     >>> ax.figure.savefig(io.BytesIO(), format="svg")
     >>> matplotlib.pyplot.close(ax.figure)
     """
