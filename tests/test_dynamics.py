@@ -46,6 +46,8 @@ from linkage.dynamics.motors import RPM, ConstantMotor, InductionMotor, LinearMo
 from linkage.dynamics.reduced import reduced_characteristics
 from linkage.model.scheme import from_dict, to_dict
 
+from _texts import slider_crank_toml
+
 G = 9.81
 
 # the course press (schemes/course_slider_crank.toml): the spec, not the library's output
@@ -669,40 +671,9 @@ def test_to_dict_returns_an_independent_copy_of_the_sections():
     assert mech.extra["loads"]["gravity"] == [0.0, -9.81]
 
 
-BARE = """
-name = "bare"
-input = "1"
-output = "B.x"
-[links.0]
-points = { O = [0.0, 0.0] }
-guides.g = { through = [0.0, 0.0], angle_deg = 0 }
-[links.1]
-line = ["O", "A"]
-length = 0.1
-[links.2]
-line = ["A", "B"]
-length = 0.3
-[links.3]
-points.B = [0.0, 0.0]
-[pairs.O]
-links = ["0", "1"]
-[pairs.A]
-links = ["1", "2"]
-[pairs.B]
-links = ["2", "3"]
-[pairs.s]
-kind = "P"
-links = ["0", "3"]
-guide = "g"
-at = "B"
-[assembly.B]
-from = "O"
-towards_deg = 0
-[dynamics]
-mean_rpm = 60
-delta = 0.05
-inertia_0 = 2.0
-"""
+#: a massless, loadless slider-crank that declares a speed, delta and I_0
+BARE = slider_crank_toml(0.1, 0.3, 'from = "O"\ntowards_deg = 0', name="bare", header='output = "B.x"',
+                         tail="[dynamics]\nmean_rpm = 60\ndelta = 0.05\ninertia_0 = 2.0\n")
 
 
 def test_a_machine_without_loads_or_masses_has_no_energy_swing_and_no_ratio_to_divide():
