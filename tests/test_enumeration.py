@@ -230,6 +230,9 @@ def test_cli_writes_the_table_and_the_schemes(capsys, tmp_path):
 @pytest.mark.parametrize("argv, named", [
     (["enumerate", "no_such_chain"], "no_such_chain"),
     (["enumerate", "four_bar", "--omega", "0"], "--omega 0"),
+    (["enumerate", "cylinder_boom"], "input 'K' is a slide (driven by the prismatic pair 'K')"),
+    (["enumerate", "piston_driven_crank"], "input '3' is a slide (driven by the prismatic pair 'slide')"),
+    (["enumerate", "five_bar_two_input"], "has 2 input links ['1', '4']"),
 ])
 def test_cli_refuses_bad_input_naming_it(capsys, argv, named):
     assert main(argv) == 2

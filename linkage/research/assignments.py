@@ -94,10 +94,18 @@ def input_pair(mech: Mechanism) -> str:
 
 
 def one_input(mech: Mechanism) -> tuple[str]:
+    """The one input link of ``mech``: a crank pinned to the frame by a revolute pair; an
+    :class:`InputError` naming the inputs otherwise (several, or a slide: a piston or a cylinder)."""
     if len(mech.inputs) != 1:
         raise InputError(f"scheme '{mech.name}' has {len(mech.inputs)} input links {list(mech.inputs)}; "
                          "pair kinds are enumerated for a chain with one input link")
-    return (mech.inputs[0],)
+    (link,) = mech.inputs
+    pair = mech.input_pair(link)
+    if mech.input_kind(link) != "angle" or pair is None or set(mech.pairs[pair].links) != {link, mech.frame}:
+        driven = f"driven by the prismatic pair '{pair}'" if pair is not None else "not pinned to the frame"
+        raise InputError(f"scheme '{mech.name}': input '{link}' is a slide ({driven}); pair kinds are enumerated "
+                         "for a crank input, a link pinned to the frame by a revolute pair (docs/enumerate.md)")
+    return (link,)
 
 
 def assignments(mech: Mechanism) -> list[Assignment]:
