@@ -436,3 +436,24 @@ def test_per_position_force_of_the_wrong_shape_is_named():
     loads = Loads(forces=(PointForce("E", "2", np.zeros((3, 2))),))
     with pytest.raises(ValueError, match=r"force at point 'E'.*shape \(5, 2\).*got shape \(3, 2\)"):
         solve_reactions(linkage.analyze(mech, np.linspace(0, 1, 5)), loads)
+
+
+@pytest.mark.parametrize("force, named", [
+    ('point = "C"\nlink = "0"', "link '0' is the frame: a force on it moves nothing and loads no pair; apply it to a "
+                                "moving link (the moving links with point 'C': ['3'])"),
+])
+def test_a_force_on_the_frame_is_refused_by_its_rule(force, named):
+    """The frame declares C (a pivot of the rocker 3 too): a force said to act on the frame is
+    refused because the frame takes it, not because the frame lacks the point."""
+    text = linkage.model.scheme.scheme_path("four_bar").read_text()
+    with pytest.raises(SchemeError) as caught:
+        linkage.loads(text + f"\n[[loads.forces]]\n{force}\nforce = [10.0, 0.0]\n")
+    assert named in str(caught.value) and "has no point" not in str(caught.value)
+
+
+def test_a_force_at_a_frame_point_only_is_refused_as_on_the_frame():
+    """A point only the frame declares: the force would act on the frame."""
+    text = linkage.model.scheme.scheme_path("four_bar").read_text().replace(
+        "points = { O = [0.0, 0.0], C = [0.3, 0.0] }", "points = { O = [0.0, 0.0], C = [0.3, 0.0], G = [0.1, -0.1] }")
+    with pytest.raises(SchemeError, match=r"link '0' is the frame: .*\(no moving link has point 'G'\)"):
+        linkage.loads(text + '\n[[loads.forces]]\npoint = "G"\nforce = [10.0, 0.0]\n')

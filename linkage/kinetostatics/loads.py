@@ -624,6 +624,13 @@ def parse_loads(mech: Mechanism, raw: Mapping[str, Any] | None) -> tuple[Loads, 
         where = f"forces[{i}] (point {point!r})"
         owners = [k for k in mech.point_links(point) if k != mech.frame] if isinstance(point, str) else []
         link = spec.get("link")
+        on_frame = isinstance(point, str) and point in mech.links[mech.frame].points
+        if link == mech.frame or (not owners and on_frame):
+            moving = f"the moving links with point {point!r}: {owners}" if owners else \
+                f"no moving link has point {point!r}"
+            problems.append(f"{where}: link {mech.frame!r} is the frame: a force on it moves nothing and loads no "
+                            f"pair; apply it to a moving link ({moving})")
+            continue
         if not owners:
             problems.append(f"{where}: unknown point {point!r} (points of moving links: "
                             f"{sorted({p for k in mech.moving_links for p in mech.links[k].points})})")
