@@ -57,21 +57,27 @@ from typing import Any
 
 import numpy as np
 
-from ..dynamics.spec import DynamicsSpec
 from assur.base import OK
 
+from ..dynamics.spec import DynamicsSpec
 from ..errors import InputError, LinkageError
 from ..kinematics.extremes import extreme_positions
-from ..kinematics.motion import Motion, analyze, angle_in_half_turn, parse_quantity, table_positions_deg
+from ..kinematics.motion import (
+    Motion,
+    analyze,
+    angle_in_half_turn,
+    parse_quantity,
+    table_positions_deg,
+)
 from ..kinetostatics.loads import loads_of
 from ..kinetostatics.plans import build_plans
 from ..kinetostatics.reactions import solve_reactions
 from ..model.mechanism import Assembly, Mechanism
-from ..structure import structure_of
 from ..model.scheme import section_of
 from ..report.results import (
     JSON_CONVENTIONS,
     DynamicsResults,
+    analog_direction,
     declared_rotation,
     dynamics_results,
     table_defaults,
@@ -79,6 +85,7 @@ from ..report.results import (
     table_sense,
 )
 from ..report.tables import TABLE_ZERO, column_unit, per_turned_angle
+from ..structure import structure_of
 from .template import Grading, Template
 
 __all__ = ["KEY_COLUMNS", "KeyItem", "AnswerKey", "answer_key", "default_points", "PASS_RULE"]
@@ -237,7 +244,7 @@ def _kinematics(mech: Mechanism, motion: Motion, rows: list[int], points, speed:
     """Positions, analogs d/dpsi, velocities and accelerations of the points; angles, analogs,
     angular velocities and accelerations of the links that turn."""
     angle = mech.coordinate.is_angle
-    direction = table_sense(motion.phi) if angle else 1    # the rule of analog_direction: d/dpsi
+    direction = analog_direction(mech, motion.phi)
     per = "rad" if angle else "m"
     at = np.asarray(rows) - 1
     found: list[_Quantity] = []
@@ -328,8 +335,8 @@ def _forces(mech: Mechanism, motion: Motion, positions: list[int], speed: float 
     return found
 
 
-def _dynamics(results: DynamicsResults, phi: np.ndarray, rows: list[int], speed: float) -> list[_Quantity]:
-    """The course method's chain per position and its scalars at the mean speed ``speed``."""
+def _dynamics(results: DynamicsResults, phi: np.ndarray, rows: list[int]) -> list[_Quantity]:
+    """The course method's chain per position and its scalars, from its law of motion."""
     law = results.report.law
     if law.method != "course":
         raise InputError(f"an answer key follows the course method (Mertsalov's), got the {law.method!r} method's "
@@ -338,21 +345,16 @@ def _dynamics(results: DynamicsResults, phi: np.ndarray, rows: list[int], speed:
         raise InputError("the dynamics results are not at the positions of the tables: compute them with the "
                          "scheme's [dynamics] positions and start")
     red = law.reduced
-    n = len(law.phi) - 1
-    psi = np.arange(n + 1) * 2 * np.pi / n
-    step = 2 * np.pi / n
-
-    def work(moment):   # the trapezoid over the table positions (docs/methods.md)
-        return np.concatenate([[0.0], np.cumsum((moment[1:] + moment[:-1]) / 2 * step)])
-
-    wm = abs(speed)
+    step = 2 * np.pi / (len(law.phi) - 1)
     resistance = red.moment_resistance
     driving = red.moment_driving + law.driving
-    work_resistance = work(resistance)
-    work_driving = law.driving_moment * psi + work(red.moment_driving)
-    delta_t = work_driving + work_resistance
-    t_variable = red.inertia_variable * wm * wm / 2
-    delta_t_prime = delta_t - t_variable
+    # the course method's own chain (linkage.dynamics.cycle.course_method), the work of all loads
+    # split into the resistance's (the same trapezoid over the table positions) and the driving work
+    work_resistance = np.concatenate([[0.0], np.cumsum((resistance[1:] + resistance[:-1]) / 2 * step)])
+    delta_t = law.details["energy_change"]
+    work_driving = delta_t - work_resistance
+    t_variable = law.details["energy_links"]
+    delta_t_prime = law.details["energy_flywheel"]
     high, low = float(np.max(delta_t_prime)), float(np.min(delta_t_prime))
     required = law.required_constant_inertia
     energy = np.abs(np.concatenate([work_resistance, work_driving, delta_t, t_variable, delta_t_prime]))
@@ -492,7 +494,7 @@ def answer_key(mech: Mechanism, grading: Grading | None = None, *, variant: str 
                          "crank)")
         else:
             results = dynamics if dynamics is not None else dynamics_results(mech)
-            quantities += _dynamics(results, phi, rows, speed)
+            quantities += _dynamics(results, phi, rows)
             meta_dynamics = json.loads(results.json())
     quantities += _stroke(mech, notes)
     items, skipped = _items(quantities, grading, notes)
