@@ -21,20 +21,19 @@ through it (``mode = "follow"``).
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
-from typing import NamedTuple
 
 import numpy as np
 from scipy.optimize import minimize_scalar
 
 from assur.base import CANNOT_ASSEMBLE, OK, SINGULAR, Group, GroupSolution, global_point
-from assur.generic import TRACE_JUMP, newton
 
 from ..errors import SchemeError
 from ..model.mechanism import Mechanism
 from ..structure import Structure, structure_of
 from .inputs import input_poses
+from .tracing import finite_poses, trace_modes, track_of
 
-__all__ = ["BranchPlan", "assembly_plans", "assembly_branches", "place_group", "random_start_modes", "BRANCH_SWEEP"]
+__all__ = ["BranchPlan", "assembly_plans", "assembly_branches", "place_group", "BRANCH_SWEEP"]
 
 #: number of input angles of the sweep that resolves conditions and finds change points
 BRANCH_SWEEP = 360
@@ -211,7 +210,7 @@ def assembly_plans(mech: Mechanism) -> tuple[BranchPlan, ...]:
         # the first branch's placement: both branches of a closed form assemble at the same angles
         first = group.position(poses, group.branches[0])
         if np.all(first.status == CANNOT_ASSEMBLE):
-            _never_assembles(mech, group, poses)
+            _never_assembles(mech, structure, plans, i, phi, poses)
         if len(group.branches) == 1:
             plan = BranchPlan(1, "keep", np.empty(0), np.empty(0, bool), period=mech.coordinate.period)
         else:
@@ -259,12 +258,42 @@ def _describe(rule) -> str:
     return f"{rule.rule} {list(rule.refs)}"
 
 
-def _never_assembles(mech, group, poses) -> None:
-    """SchemeError naming the group, which assembles at no angle of the sweep, and the reason."""
+def _never_assembles(mech, structure, plans, i, phi, poses) -> None:
+    """SchemeError naming group ``i``, which assembles at no angle of the sweep ``phi``, and the
+    reason: the upstream assembly condition when the group assembles with another branch of an
+    earlier group, else the dimensional reason (its own, or the group's "check the dimensions")."""
+    group = structure.groups[i]
+    head = f"mechanism '{mech.name}': group {group!r} cannot be assembled at any input {mech.coordinate.kind}"
+    other = _assembles_with_other_branch(mech, structure, plans, i, phi)
+    if other is not None:
+        j, count = other
+        rule = next((r for r in mech.assembly if any(r.point in mech.links[k].points
+                                                     for k in structure.groups[j].links)), None)
+        named = f"the condition on point '{rule.point}' ({_describe(rule)})" if rule is not None else "its branch"
+        raise SchemeError(
+            f"{head} with the assembly mode that {named} chooses for group {structure.groups[j]!r}; with that "
+            f"group's other branch it assembles at {count} of {len(phi)} input {mech.coordinate.kind}s of the "
+            "sweep: check that condition")
     reason = group.assembly_failure(poses)
-    raise SchemeError(
-        f"mechanism '{mech.name}': group {group!r} cannot be assembled at any input {mech.coordinate.kind}"
-        + (f": {reason}" if reason else "") + " (check the dimensions of its links)")
+    raise SchemeError(head + (f": {reason}" if reason else "") + " (check the dimensions of its links)")
+
+
+def _assembles_with_other_branch(mech, structure, plans, i, phi) -> tuple[int, int] | None:
+    """The earlier closed-form group with two branches whose other branch lets group ``i``
+    assemble at some sweep angles, and at how many (None when there is none)."""
+    group = structure.groups[i]
+    if getattr(group, "tracked", False):
+        return None
+    for j in structure.needed_groups(group.known_links):
+        if len(structure.groups[j].branches) < 2 or plans[j].track is not None:
+            continue
+        flipped = list(plans)
+        flipped[j] = replace(plans[j], branch=-plans[j].branch)
+        known = _chain(mech, structure, flipped, i, phi)
+        count = int(np.sum(group.position(known, group.branches[0]).status != CANNOT_ASSEMBLE))
+        if count:
+            return j, count
+    return None
 
 
 def _rules_per_group(mech: Mechanism, structure: Structure) -> dict:
@@ -318,31 +347,15 @@ def _rule_score(mech: Mechanism, rule, poses) -> np.ndarray:
 
 
 # ----------------------------------------------------------------------------------------------
-# groups solved by Newton's method: their modes traced over the sweep
+# groups solved by Newton's method: their modes traced over the sweep (linkage.kinematics.tracing)
 # ----------------------------------------------------------------------------------------------
-
-#: multi-start guesses at the first angle for a group that cannot list its modes
-STARTS = 64
-#: halvings of a sweep step tried where a traced mode jumps or Newton's method fails between two
-#: sweep angles (the step shrinks to 1/16 of the sweep's) before the mode is declared ended there
-REFINEMENTS = 4
-
-
-class _Trace(NamedTuple):
-    """One assembly mode followed over the sweep: its poses ``{link: (M, 3)}`` at the sweep's M
-    angles (NaN where it does not exist) and the poses ``{link: (E, 3)}`` at the E angles
-    ``refined_at`` (rad) between them where the step was refined."""
-
-    rows: dict[str, np.ndarray]
-    refined_at: np.ndarray
-    refined: dict[str, np.ndarray]
 
 
 def _traced_plan(mech, structure, plans, i, rule, poses, phi) -> BranchPlan:
-    """The plan of a group solved by Newton's method: each assembly mode found at the sweep's
-    angles and followed from angle to angle with step control (nearest listed solution, or
-    Newton's method from the previous angle); the declared condition chooses one (as for two
-    branches); the change points where the chosen mode meets another are recorded."""
+    """The plan of a group solved by Newton's method: its assembly modes found over the sweep and
+    each followed over it (:func:`linkage.kinematics.tracing.trace_modes`); the declared condition
+    chooses one (:func:`_chosen_trace`); the change points where the chosen mode meets another
+    are recorded."""
     group = structure.groups[i]
     known = {k: poses[k] for k in group.known_links}
 
@@ -351,291 +364,68 @@ def _traced_plan(mech, structure, plans, i, rule, poses, phi) -> BranchPlan:
         return {k: chain[k] for k in group.known_links}
 
     periodic = mech.input_range is None
-    listed = group.modes(known)
-    traces = _follow(group, phi, known, known_at, periodic, listed)
-    traces = _distinct(group, traces)
+    traces = trace_modes(group, phi, known, known_at, periodic)
     if not traces:
-        _never_assembles(mech, group, known)
-    if len(traces) == 1 and rule is None:
-        chosen = 0
-    else:
-        scores = []
-        for trace in traces:
-            trial = {**poses, **trace.rows}
-            score = _rule_score(mech, rule, trial)
-            if rule.phi is not None:
-                near = int(np.argmin(_apart(phi, rule.phi, mech)))
-                score = score[near:near + 1]
-            with np.errstate(invalid="ignore"):
-                scores.append(int(np.sum(score > 1e-9 * mech.size)))
-        order = np.argsort(scores)[::-1]
-        if len(traces) > 1 and scores[order[0]] == scores[order[1]]:
-            raise SchemeError(
-                f"mechanism '{mech.name}': assembly of point '{rule.point}' ({_describe(rule)}) does not tell "
-                f"the assembly modes of {group!r} apart (two of its {len(traces)} modes satisfy it at "
-                f"{scores[order[0]]} of {len(phi)} input angles; choose a condition that only one mode meets)")
-        chosen = int(order[0])
-    plan = BranchPlan(1, "keep", np.empty(0), np.empty(0, bool), _track(phi, traces[chosen], periodic), periodic,
+        _never_assembles(mech, structure, plans, i, phi, known)
+    chosen = traces[_chosen_trace(mech, group, rule, traces, poses, phi)]
+    plan = BranchPlan(1, "keep", np.empty(0), np.empty(0, bool), track_of(phi, chosen, periodic), periodic,
                       mech.coordinate.period)
-    changes = _traced_change_points(mech, group, known, known_at, plan, phi, traces[chosen].rows)
+    changes = _traced_change_points(mech, group, known, known_at, plan, phi, chosen.rows)
     return replace(plan, change_points=changes, swaps=np.zeros(len(changes), bool))
 
 
-def _track(phi: np.ndarray, trace: _Trace, periodic: bool) -> tuple[np.ndarray, dict[str, np.ndarray]]:
-    """The samples of a trace, sweep angles and refined ones, in increasing angle (over a turn,
-    folded into the turn that starts at the sweep's first angle)."""
-    angles = np.concatenate([phi, trace.refined_at])
-    if periodic:
-        angles = (angles - phi[0]) % TWO_PI + phi[0]
-    order = np.argsort(angles, kind="stable")
-    return angles[order], {k: np.concatenate([v, trace.refined[k]])[order] for k, v in trace.rows.items()}
-
-
-def _follow(group, phi, known, known_at, periodic: bool, listed) -> list[_Trace]:
-    """Every assembly mode found at the first sweep angle where there is one and followed over
-    the sweep ``phi`` (M angles; over a turn, round to the angle before the first).
-
-    ``known``: poses ``{link: (M, 3)}`` of the group's known links at the sweep; ``known_at``:
-    the same at any angles (rad, ``(n,)``); ``listed``: :meth:`NewtonGroup.modes` at the sweep,
-    or None (the modes are then found by Newton's method from :data:`STARTS` random starts at the
-    first angle and continued by Newton's method). Where a mode jumps by more than
-    :data:`TRACE_JUMP` of the size or Newton's method fails between two sweep angles, the step is
-    halved up to :data:`REFINEMENTS` times (:func:`_refine`); a mode that still cannot be
-    followed ends there (NaN from there on).
-    """
-    M = len(phi)
-    size = float(np.max(group.size))
-    if listed is None:
-        first, starts = _first_modes(group, known, size)
-    else:
-        present = np.flatnonzero(listed[1].any(axis=1))
-        first = int(present[0]) if len(present) else 0
-        slots = np.flatnonzero(listed[1][first])
-        starts = {k: v[first, slots] for k, v in listed[0].items()}
-    count = len(next(iter(starts.values())))
-    if not count:
-        return []
-    rows = {k: np.full((M, count, 3), np.nan) for k in group.links}
-    for k in group.links:
-        rows[k][first] = starts[k]
-    refined_at, refined_from, refined = [], [], {k: [] for k in group.links}
-    step = phi[1] - phi[0]
-    current, angle, previous = starts, phi[first], None
-    for m in ((first + s) % M for s in range(1, M)) if periodic else range(first + 1, M):
-        options = None if listed is None else ({k: v[m:m + 1] for k, v in listed[0].items()}, listed[1][m:m + 1])
-        reached, ok = _advance(group, current, {k: v[m:m + 1] for k, v in known.items()}, options, size, previous)
-        retry = np.flatnonzero(~ok & _finite(current))
-        if len(retry):
-            fixed, good, samples = _refine(group, {k: v[retry] for k, v in current.items()}, angle, step,
-                                           known_at, listed is not None, size)
-            for k in group.links:
-                reached[k][retry] = fixed[k]
-            ok[retry] = good
-            for j, at, poses in samples:
-                refined_at.append(at)
-                refined_from.append(np.full(len(at), retry[j]))
-                for k in group.links:
-                    refined[k].append(poses[k])
-        previous = current if not len(retry) else None      # a refined step: no even pace to extrapolate
-        current = {k: np.where(ok[:, None], v, np.nan) for k, v in reached.items()}
-        for k in group.links:
-            rows[k][m] = current[k]
-        angle = angle + step
-    at = np.concatenate(refined_at) if refined_at else np.empty(0)
-    owner = np.concatenate(refined_from) if refined_from else np.empty(0, int)
-    extra = {k: np.concatenate(v) if v else np.empty((0, 3)) for k, v in refined.items()}
-    return [_Trace({k: v[:, c] for k, v in rows.items()}, at[owner == c], {k: v[owner == c] for k, v in extra.items()})
-            for c in range(count)]
-
-
-#: sweep indices between the tries of :func:`_first_modes` after the first one fails
-SCAN = 8
-
-
-def _first_modes(group, known, size: float) -> tuple[int, dict[str, np.ndarray]]:
-    """The first sweep index where Newton's method from random starts (:func:`random_start_modes`) finds
-    assembly modes, and the modes found there: index 0, else every :data:`SCAN`-th index, then
-    back to the earliest index after the last one without modes (a group that does not assemble
-    at the sweep's start is traced from where it does, instead of being taken for one that never
-    assembles). No modes anywhere: index 0 and none."""
-    M = len(next(iter(known.values())))
-
-    def at(m: int) -> dict[str, np.ndarray]:
-        return random_start_modes(group, {k: v[m:m + 1] for k, v in known.items()}, size)
-
-    def some(modes) -> bool:
-        return len(next(iter(modes.values()))) > 0
-
-    found = at(0)
-    if some(found):
-        return 0, found
-    empty = 0
-    for m in range(SCAN, M, SCAN):
-        found = at(m)
-        if some(found):
-            for earlier in range(empty + 1, m):
-                modes = at(earlier)
-                if some(modes):
-                    return earlier, modes
-            return m, found
-        empty = m
-    return 0, at(0)
-
-
-def random_start_modes(group, at0: dict[str, np.ndarray], size: float, around: dict[str, np.ndarray] | None = None,
-                       besides: dict[str, np.ndarray] | None = None) -> dict[str, np.ndarray]:
-    """The distinct assembly modes ``{link: (C, 3)}`` Newton's method reaches from :data:`STARTS`
-    random starts at one position, where the known links have the poses ``at0`` ``{link: (1, 3)}``.
-
-    The starts lie within ``size`` (m) in x and y of the centroid of the group's contact points
-    with its links at the poses ``around`` ``{link: (1, 3)}`` (default: each at the origin,
-    unturned), each link turned at random; the generator is seeded (0) at every call, so that the
-    same inputs give the same modes in the same order. A solution counts where Newton's method
-    converged and the group closes to 1e-9 of ``size``; it is a new mode when it lies farther than
-    1e-6 of ``size`` (:func:`poses_distance`) from every mode kept before it and from ``besides``
-    (a mode ``{link: (3,)}`` already known, not returned).
-    """
-    rng = np.random.default_rng(0)
-    known = {k: np.repeat(v, STARTS, axis=0) for k, v in at0.items()}
-    at = {k: np.zeros((1, 3)) for k in group.links} if around is None else around
-    anchors = group.contact_points({**at0, **at})
-    centre = np.nanmean(anchors[0], axis=0)
-    guesses = {k: np.column_stack([centre[0] + size * rng.uniform(-1, 1, STARTS),
-                                   centre[1] + size * rng.uniform(-1, 1, STARTS),
-                                   rng.uniform(-np.pi, np.pi, STARTS)]) for k in group.links}
-    solved, converged = newton(group, known, guesses)
-    closure = np.max(np.abs(group.residual({**known, **solved})), axis=1)
-    with np.errstate(invalid="ignore"):
-        good = np.flatnonzero(converged & (closure <= 1e-9 * size))
-    kept: list[int] = []
-    for n in good:
-        candidate = {k: v[n] for k, v in solved.items()}
-        gap = poses_distance(candidate, {k: v[kept] for k, v in solved.items()}, group.links, size)
-        if np.all(gap > 1e-6 * size) and (besides is None
-                                          or poses_distance(candidate, besides, group.links, size) > 1e-6 * size):
-            kept.append(int(n))
-    return {k: v[kept] for k, v in solved.items()}
-
-
-def _advance(group, current, known, options, size: float, previous=None):
-    """One step of every trace: from its poses ``current`` ``{link: (C, 3)}`` to the next angle,
-    where the known links have the poses ``known`` ``{link: (1, 3)}`` and the listed modes are
-    ``options`` (``({link: (1, K, 3)}, valid (1, K))``, or None). Each trace takes the listed
-    mode nearest to it, else (none listed, or none near: a listing may lose a mode next to a
-    position where two modes meet) the point Newton's method reaches from it. Returns the poses
-    reached and where the step is good: a position that closes to 1e-9 of the size, within
-    :data:`TRACE_JUMP` of the size of the current one. ``previous``: the poses one equal step
-    before ``current``, when there are: Newton's method then starts from their linear
-    extrapolation (one iteration fewer on a smooth trace)."""
-    C = len(next(iter(current.values())))
-    reached = {k: np.full((C, 3), np.nan) for k in group.links}
-    if options is not None:
-        candidates, valid = options
-        gap2 = sum(_pose_distance(candidates[k][0][None], current[k][:, None], size) ** 2 for k in group.links)
-        gap2 = np.where(valid[0][None], np.nan_to_num(gap2, nan=np.inf), np.inf)            # (C, K)
-        best = np.argmin(gap2, axis=1)
-        reached = {k: candidates[k][0][best] for k in group.links}
-    ok = _moved(group, reached, current, size) <= TRACE_JUMP * size
-    rows = np.flatnonzero(~ok & _finite(current))
-    if len(rows):
-        here = {k: np.repeat(v, len(rows), axis=0) for k, v in known.items()}
-        start = {k: v[rows] for k, v in current.items()}
-        if previous is not None:
-            ahead = {k: 2 * v[rows] - previous[k][rows] for k, v in current.items()}
-            usable = _finite(ahead)
-            start = {k: np.where(usable[:, None], ahead[k], v) for k, v in start.items()}
-        solved, _ = newton(group, here, start)
-        closure = np.max(np.abs(group.residual({**here, **solved})), axis=1)
-        with np.errstate(invalid="ignore"):
-            ok[rows] = (closure <= 1e-9 * size) & (_moved(group, solved, {k: v[rows] for k, v in current.items()},
-                                                          size) <= TRACE_JUMP * size)
-        for k in group.links:
-            reached[k][rows] = solved[k]
-    return reached, ok
-
-
-def _moved(group, a: dict[str, np.ndarray], b: dict[str, np.ndarray], size: float) -> np.ndarray:
-    """Distance ``(C,)``, m, between poses of the group's links (``inf`` where one is NaN)."""
-    gap = poses_distance(a, b, group.links, size)
-    return np.nan_to_num(gap, nan=np.inf)
-
-
-def _refine(group, current, angle: float, step: float, known_at, listing: bool, size: float):
-    """Follow the R traces at poses ``current`` ``{link: (R, 3)}`` (at the input angle ``angle``)
-    to ``angle + step`` in 2, 4 ... 2**REFINEMENTS equal sub-steps, until every sub-step is good.
-
-    Returns
-    -------
-    reached : dict of link -> ndarray (R, 3)
-        Poses at ``angle + step`` (NaN where the trace could not be followed).
-    good : ndarray of bool (R,)
-    samples : list of (j, angles (n-1,), {link: (n-1, 3)})
-        The poses of trace j at the intermediate sub-angles, rad.
-    """
-    R = len(next(iter(current.values())))
-    reached = {k: np.full((R, 3), np.nan) for k in group.links}
-    good = np.zeros(R, bool)
-    samples = []
-    todo = np.arange(R)
-    for depth in range(1, REFINEMENTS + 1):
-        n = 2**depth
-        angles = angle + step * np.arange(1, n + 1) / n
-        known = known_at(angles)
-        listed = group.modes(known) if listing else None
-        q = {k: v[todo] for k, v in current.items()}
-        alive = np.ones(len(todo), bool)
-        path = {k: np.empty((n, len(todo), 3)) for k in group.links}
-        for f in range(n):
-            options = None if listed is None else ({k: v[f:f + 1] for k, v in listed[0].items()}, listed[1][f:f + 1])
-            q, ok = _advance(group, q, {k: v[f:f + 1] for k, v in known.items()}, options, size)
-            alive &= ok
-            q = {k: np.where(alive[:, None], v, np.nan) for k, v in q.items()}
-            for k in group.links:
-                path[k][f] = q[k]
-        for j in np.flatnonzero(alive):
-            samples.append((int(todo[j]), angles[:-1], {k: path[k][:-1, j] for k in group.links}))
-            for k in group.links:
-                reached[k][todo[j]] = path[k][-1, j]
-        good[todo[alive]] = True
-        todo = todo[~alive]
-        if not len(todo):
-            break
-    return reached, good, samples
-
-
-def _finite(poses: dict[str, np.ndarray]) -> np.ndarray:
-    """``(N,)``: where every pose of ``poses`` is finite."""
-    return np.all(np.concatenate([np.isfinite(v) for v in poses.values()], axis=1), axis=1)
-
-
-def _distinct(group, traces: list[_Trace]) -> list[_Trace]:
-    """Traces with the ones that coincide with an earlier one (at every angle both exist) removed."""
-    size = float(np.max(group.size))
-    kept: list[_Trace] = []
+def _chosen_trace(mech, group, rule, traces, poses, phi) -> int:
+    """Which of the traced modes the group's assembly condition declares: the one that satisfies
+    a readable condition at the most sweep angles (or at its ``phi_deg``), or for ``branch = +1 /
+    -1`` the one whose Jacobian determinant has that sign. Raises SchemeError, naming the rule,
+    when the condition cannot choose."""
+    if rule is None:
+        return 0      # one mode only (a rule is required where there are several)
+    where = f"mechanism '{mech.name}': assembly of group {group!r}"
+    if rule.rule == "branch":
+        signs = [_mode_sign(group, {**poses, **t.rows}, t.rows) for t in traces]
+        matching = [n for n, s in enumerate(signs) if s == rule.value]
+        if len(matching) == 1:
+            return matching[0]
+        count = {+1: signs.count(1), -1: signs.count(-1)}
+        raise SchemeError(
+            f"{where}: branch = {rule.value:+d} chooses the mode whose Jacobian determinant has that sign, but "
+            f"{len(matching)} of its {len(traces)} assembly modes have it ({count[1]} positive, {count[-1]} "
+            f"negative); declare the mode by a point instead (left_of, right_of or towards, with phi_deg if "
+            "needed; docs/groups.md)")
+    scores = []
     for trace in traces:
-        same = False
-        for other in kept:
-            gap = poses_distance(trace.rows, other.rows, trace.rows, size)
-            both = np.isfinite(gap)
-            if both.any() and np.all(gap[both] <= 1e-6 * size):
-                same = True
-                break
-        if not same:
-            kept.append(trace)
-    return kept
+        score = _rule_score(mech, rule, {**poses, **trace.rows})
+        if rule.phi is not None:
+            near = int(np.argmin(_apart(phi, rule.phi, mech)))
+            score = score[near:near + 1]
+        with np.errstate(invalid="ignore"):
+            scores.append(int(np.sum(score > 1e-9 * mech.size)))
+    order = np.argsort(scores, kind="stable")[::-1]
+    best = scores[order[0]]
+    at = (f"at the input angle {np.degrees(rule.phi):.6g} deg" if rule.phi is not None else
+          f"at any of the {len(phi)} input angles of the sweep")
+    if best == 0:
+        raise SchemeError(f"{where}: none of its {len(traces)} assembly modes places point '{rule.point}' "
+                          f"{_describe(rule)} {at}; check the condition (and its phi_deg)")
+    if len(traces) > 1 and scores[order[1]] == best:
+        raise SchemeError(
+            f"{where}: assembly of point '{rule.point}' ({_describe(rule)}) does not tell its assembly modes "
+            f"apart (two of its {len(traces)} modes satisfy it at {best} of {len(phi)} input angles; choose a "
+            "condition that only one mode meets, or give the input angle at which it holds with phi_deg)")
+    return int(order[0])
 
 
-def _pose_distance(a: np.ndarray, b: np.ndarray, size: float) -> np.ndarray:
-    """Distance between poses ``(..., 3)``, m (angles weighted by ``size``, wrapped)."""
-    d = a - b
-    turn = (d[..., 2] + np.pi) % TWO_PI - np.pi
-    return np.sqrt(d[..., 0] ** 2 + d[..., 1] ** 2 + (size * turn) ** 2)
-
-
-def poses_distance(a: dict[str, np.ndarray], b: dict[str, np.ndarray], links, size: float) -> np.ndarray:
-    """Distance between the poses ``(..., 3)`` of several links, m: the root of the sum of
-    :func:`_pose_distance` squared over ``links``."""
-    return np.sqrt(sum(_pose_distance(a[k], b[k], size) ** 2 for k in links))
+def _mode_sign(group, merged, rows) -> int:
+    """The sign (+1 / -1) of the group's Jacobian determinant along a traced mode (the sign it has
+    at most of the sweep angles where the mode exists; 0 when it has none)."""
+    ok = finite_poses(rows)
+    if not ok.any():
+        return 0
+    at = {k: v[ok] for k, v in merged.items()}
+    signs = group.conditioning(group.jacobians(at)[0], at)[1]
+    total = float(np.sum(signs))
+    return int(np.sign(total))
 
 
 def _traced_change_points(mech, group, known, known_at, plan: BranchPlan, phi, rows) -> np.ndarray:
@@ -645,7 +435,7 @@ def _traced_change_points(mech, group, known, known_at, plan: BranchPlan, phi, r
     limit position where the mode ends)."""
     M = len(phi)
     r = np.full(M, np.nan)
-    ok = _finite(rows)
+    ok = finite_poses(rows)
     if ok.any():
         merged = {**{k: v[ok] for k, v in known.items()}, **{k: v[ok] for k, v in rows.items()}}
         r[ok] = group.conditioning(group.jacobians(merged)[0], merged)[0]

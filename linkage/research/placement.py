@@ -15,7 +15,7 @@ forms on the reference branch) of a combination whose assembly conditions are no
 that it has no assembly plans, from the reference angle in coarse adaptive steps, and stops at the
 first sign that the mode is no sensible default (a limit position, a conditioning below
 :data:`MIN_CONDITIONING`). The other modes at the reference angle are found as the plans find a
-group's modes (:func:`~linkage.kinematics.assembly.random_start_modes`).
+group's modes (:func:`~linkage.kinematics.tracing.random_start_modes`).
 """
 
 from __future__ import annotations
@@ -30,7 +30,7 @@ from assur.base import OK, SINGULAR, global_point
 from assur.generic import TRACE_JUMP
 
 from ..errors import AssemblyError, StructureError
-from ..kinematics.assembly import poses_distance, random_start_modes
+from ..kinematics.tracing import poses_distance, random_start_modes
 from ..kinematics.inputs import input_poses
 from ..kinetostatics.loads import loads_of
 from ..model.mechanism import Mechanism
@@ -263,7 +263,7 @@ def _chain_at(place: Placement, phi: float, near: dict[str, np.ndarray], links: 
 def _other_modes(group, known: dict[str, np.ndarray], mode: dict[str, np.ndarray]) -> list[dict[str, np.ndarray]]:
     """The group's assembly modes at one position other than ``mode`` (``{link: (3,)}``): every mode
     a kind lists (the triad), else those Newton's method reaches from random starts around the mode
-    (:func:`~linkage.kinematics.assembly.random_start_modes`); each ``{link: (3,)}``, distinct."""
+    (:func:`~linkage.kinematics.tracing.random_start_modes`); each ``{link: (3,)}``, distinct."""
     size = float(group.size)
     listed = group.modes(known)
     if listed is None:
