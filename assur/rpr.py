@@ -64,3 +64,11 @@ class RPR(Dyad):
             return (f"|{self.ext1.name}{self.ext2.name}| <= {np.max(d):.6g} m at every angle but the "
                     f"slot '{self.inner.name}' runs {np.min(e):.6g} m from {self.ext2.name}")
         return None
+
+    def assembly_margin(self, poses):
+        """``(N,)`` m: the distance AC less the slot's offset from C (negative where the dyad
+        cannot be assembled)."""
+        l1, l2 = self.links
+        frames = self._frames(poses)
+        A, C = self.known_point(frames, self.ext1, l1), self.known_point(frames, self.ext2, l2)
+        return np.hypot(A[0] - C[0], A[1] - C[1]) - np.abs(self._offset())

@@ -57,3 +57,9 @@ class RRP(Dyad):
                     f"{self.inner.name} on guide '{self.ext2.name}', but the link {self.ext1.name}"
                     f"{self.inner.name} is {np.max(length):.6g} m long")
         return None
+
+    def assembly_margin(self, poses):
+        """``(N,)`` m: the length AB less the distance of A from the line B runs on (negative
+        where the dyad cannot be assembled)."""
+        A, G_B, u, _, length = self._line_of_b(self._frames(poses))
+        return length - np.abs(u[0] * (A[1] - G_B[1]) - u[1] * (A[0] - G_B[0]))

@@ -62,3 +62,13 @@ class RRR(Dyad):
             return (f"|{a}{c}| <= {np.max(d):.6g} m at every angle but |{a}{b} - {c}{b}| = "
                     f"{np.min(np.abs(len1 - len2)):.6g} m")
         return None
+
+    def assembly_margin(self, poses):
+        """``(N,)`` m: by how much the triangle A, B, C closes, ``min(|AB| + |CB| - |AC|, |AC| - ||AB| - |CB||)``
+        (negative where the dyad cannot be assembled)."""
+        l1, l2 = self.links
+        frames = self._frames(poses)
+        A, C = self.known_point(frames, self.ext1, l1), self.known_point(frames, self.ext2, l2)
+        d = np.hypot(C[0] - A[0], C[1] - A[1])
+        len1, len2 = self._lengths()
+        return np.minimum(len1 + len2 - d, d - np.abs(len1 - len2))

@@ -23,7 +23,7 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 import numpy as np
-from scipy.optimize import minimize_scalar
+from scipy.optimize import brentq, minimize_scalar
 
 from assur.base import CANNOT_ASSEMBLE, OK, SINGULAR, Group, GroupSolution, global_point
 
@@ -210,6 +210,7 @@ def assembly_plans(mech: Mechanism) -> tuple[BranchPlan, ...]:
         # the first branch's placement: both branches of a closed form assemble at the same angles
         first = group.position(poses, group.branches[0])
         if np.all(first.status == CANNOT_ASSEMBLE):
+            _narrow_window(mech, structure, plans, i, phi, poses)
             _never_assembles(mech, structure, plans, i, phi, poses)
         if len(group.branches) == 1:
             plan = BranchPlan(1, "keep", np.empty(0), np.empty(0, bool), period=mech.coordinate.period)
@@ -276,6 +277,40 @@ def _never_assembles(mech, structure, plans, i, phi, poses) -> None:
             "sweep: check that condition")
     reason = group.assembly_failure(poses)
     raise SchemeError(head + (f": {reason}" if reason else "") + " (check the dimensions of its links)")
+
+
+def _narrow_window(mech, structure, plans, i, phi, poses) -> None:
+    """SchemeError when group ``i``, which assembles at no angle of the sweep ``phi``, does assemble
+    between two of them: where its :meth:`~assur.base.Group.assembly_margin` comes closest to 0,
+    maximised within a sweep step; the message gives the window and how to analyse it."""
+    group = structure.groups[i]
+    margin = group.assembly_margin(poses)
+    if margin is None or len(phi) < 2:
+        return
+    step = abs(phi[1] - phi[0])
+    low = min(0.0, 1e-9 * mech.size)
+
+    def at(x: float) -> float:
+        value = group.assembly_margin(_chain(mech, structure, plans, i, np.array([x])))
+        return float(value[0]) if np.isfinite(value[0]) else -np.inf
+
+    near = np.argsort(np.nan_to_num(-np.asarray(margin, float), nan=np.inf))[:4]
+    for k in near:
+        best = minimize_scalar(lambda x: -at(x), bounds=(phi[k] - step, phi[k] + step), method="bounded",
+                               options={"xatol": 1e-13})
+        if -best.fun <= low:
+            continue
+        x = float(best.x)
+        ends = [brentq(at, x - side * step, x, xtol=1e-14) if at(x - side * step) < 0 else x - side * step
+                for side in (1, -1)]
+        a, b = sorted(mech.coordinate.shown(np.array(ends)))
+        unit = mech.coordinate.shown_unit
+        key = "range_deg" if mech.coordinate.is_angle else "range"
+        raise SchemeError(
+            f"mechanism '{mech.name}': group {group!r} can be assembled only for input {mech.coordinate.kind}s from "
+            f"{a:.6g} to {b:.6g} {unit}, a window narrower than the {mech.coordinate.shown(step):.3g} {unit} "
+            f"step of the sweep that resolves assembly conditions (it closes by at most {-best.fun:.3g} m there): "
+            f"the input cannot turn; to analyse that window, declare {key} = [{a:.6g}, {b:.6g}] for the input")
 
 
 def _assembles_with_other_branch(mech, structure, plans, i, phi) -> tuple[int, int] | None:
