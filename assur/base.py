@@ -428,6 +428,12 @@ class Group(ABC):
         (e.g. ``"|AC| >= 2.1 m but AB + CB = 2 m"``), or None when there is none to tell."""
         return None
 
+    def assembly_margin(self, poses: Poses) -> np.ndarray | None:
+        """Hook: ``(N,)`` m, by how much the group closes at the known ``poses`` (negative where it
+        cannot be assembled, 0 at a limit position), for the kinds where one number says it;
+        None otherwise."""
+        return None
+
     # -- the constraint system -----------------------------------------------------------------
     def residual(self, poses: Poses) -> np.ndarray:
         """Stacked constraint residuals ``(N, 2 * n_joints)`` (prismatic angle rows scaled to m)."""
