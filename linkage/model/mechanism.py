@@ -314,8 +314,9 @@ class InputCoordinate:
 
     def describe(self, values, limit: int = 20) -> str:
         """``"input angle(s) (deg): 10, 20"`` or ``"input slide(s) (m): 0.1, 0.2"`` for values in
-        the SI unit (at most ``limit`` shown)."""
-        values = list(self.shown(values))
+        the SI unit (at most ``limit`` shown); angles folded into [0, 360) deg, whatever turn of a
+        longer run they come from."""
+        values = list(self.shown(values) % 360.0 if self.is_angle else self.shown(values))
         shown = ", ".join(f"{v:.6g}" for v in values[:limit]) + (" ..." if len(values) > limit else "")
         return f"input {self.kind}(s) ({self.shown_unit}): {shown}"
 
