@@ -36,7 +36,7 @@ TWO_PI = 2 * np.pi
 #: multi-start guesses at one angle for a group that cannot list its modes
 STARTS = 64
 #: angles of the sweep (evenly spread) where a group that cannot list its modes is searched for them
-SEEDS = 24
+SEEDS = 8
 #: halvings of a sweep step tried where a traced mode jumps or Newton's method fails between two
 #: sweep angles (the step shrinks to 1/16 of the sweep's) before the mode is declared ended there
 REFINEMENTS = 4
