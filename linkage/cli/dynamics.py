@@ -9,7 +9,7 @@ import contextlib
 
 import numpy as np
 
-from ..dynamics.equation import simulate
+from ..dynamics.equation import StartupStall, simulate
 from ..dynamics.spec import override_spec
 from ..dynamics.stroke import stroke_motion
 from ..errors import InputError
@@ -135,7 +135,7 @@ def run(args: argparse.Namespace) -> int:
     spec = None
     if args.method == "ode":
         with _options_named(args):
-            spec = override_spec(mech, None, args.delta, input_speed(args), args.positions)
+            spec = override_spec(mech, None, args.delta, input_speed(args, mech), args.positions)
         if args.transient and spec.initial_speed is None:
             raise InputError(f"--transient: scheme '{mech.name}' declares no speed to start from: give "
                              "initial_rpm (or initial_speed, rad/s) in its [dynamics] section")
@@ -144,7 +144,7 @@ def run(args: argparse.Namespace) -> int:
         note("note", f"{first}shooting for the motor-driven steady state{then}; this takes a few seconds")
     with _options_named(args):
         results = dynamics_results(mech, args.method, positions=args.positions, delta=args.delta,
-                                   mean_speed=input_speed(args))
+                                   mean_speed=input_speed(args, mech))
     report, summary = results.report, dict(results.summary)
     for line in report.notes:
         note("note", line)
@@ -154,12 +154,13 @@ def run(args: argparse.Namespace) -> int:
     direction = law.reduced.rotation
     n = len(law.phi) - 1
     if args.transient:
-        transient = simulate(mech, spec, constant_inertia=law.constant_inertia)
+        transient, stalled = _startup(mech, spec, law)
         columns = transient.columns()
         summary.update(initial_speed=spec.initial_speed)
+        until = f", up to the stall at t = {stalled.t:.4g} s" if stalled is not None else ""
         start = (f"t = 0 at phi0 = {round(float(np.degrees(law.phi[0])), 10) + 0.0:.10g} deg, "
                  f"|omega| = {spec.initial_speed:.6g} rad/s; phi_deg counts from it "
-                 f"{sense_in_words(direction)}, 360 per cycle, {spec.cycles} cycles")
+                 f"{sense_in_words(direction)}, 360 per cycle, {spec.cycles} cycles{until}")
         always = ("t", "phi_deg")
     else:
         columns = results.columns
@@ -177,6 +178,16 @@ def run(args: argparse.Namespace) -> int:
         summary = shown
     emit(columns, args, summary, _dynamics_view, always=always)
     return 0
+
+
+def _startup(mech, spec, law):
+    """The start-up transient of ``--transient`` and its stall (None when it does not stall): a
+    start-up that stalls is the motion up to the stall (the pipeline's note already said where
+    and why)."""
+    try:
+        return simulate(mech, spec, constant_inertia=law.constant_inertia), None
+    except StartupStall as stalled:
+        return stalled.transient, stalled.stall
 
 
 @contextlib.contextmanager

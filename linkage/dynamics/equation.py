@@ -5,7 +5,9 @@ The motor (:mod:`linkage.dynamics.motors`) drives the machine through
 ``scipy.integrate.solve_ivp``:
 
 - :func:`simulate` -- a start-up transient over K cycles (a :class:`Transient`), from a given
-  speed or from rest (its first degree integrated in time);
+  speed or from rest (its first degree integrated in time); a start-up whose speed falls to zero
+  raises :class:`StartupStall`, which holds the motion up to the stall and where and why it
+  stalls (a :class:`Stall`);
 - :func:`steady_state` -- the periodic steady state by shooting on ``omega(0) = omega(2 pi)``
   (a :class:`~linkage.dynamics.cycle.LawOfMotion` with method "ode").
 """
@@ -44,7 +46,7 @@ from .spec import (
     require_full_turn,
 )
 
-__all__ = ["REST_START_ANGLE", "Transient", "simulate", "steady_state"]
+__all__ = ["REST_START_ANGLE", "Stall", "StartupStall", "Transient", "simulate", "steady_state"]
 
 #: ``scipy.integrate.solve_ivp``'s status when an integration step failed
 IVP_FAILED = -1
@@ -69,6 +71,104 @@ class Transient:
         signed)."""
         return {"t": np.asarray(self.t, dtype=float), "phi_deg": np.degrees(self.psi),
                 "omega": np.asarray(self.omega, dtype=float)}
+
+
+@dataclass(frozen=True)
+class Stall:
+    """Where and why a start-up transient stalls: its speed falls to zero (omega -> 0).
+
+    A stall at ``psi`` needs the driving moment at rest below the resistance there,
+    ``M_d(0) < -M_red(psi)`` (at omega = 0 the equation of motion leaves ``I domega/dt =
+    M_d(0) + M_red(psi)``). So a driving moment at rest above :attr:`largest_resisting`, the
+    largest resisting reduced moment over the turn, stalls from no start: :attr:`shortfall` is
+    how much more moment at rest that takes.
+
+    Attributes
+    ----------
+    psi : float
+        Crank angle travelled from the start to the stall, rad (from position 1 in the direction
+        of rotation, 2 pi per turn; 0: the machine does not move from position 1).
+    t : float
+        Time from the start to the stall, s.
+    initial_speed : float
+        |omega| at the start of the transient, rad/s (0: from rest).
+    starting_moment : float
+        The driving moment at rest ``M_d(0)`` at the crank, N m (the motor's starting torque, or
+        the constant moment from the cycle balance when no motor is declared).
+    resisting : float
+        The resisting reduced moment ``-M_red`` at the stall, N m.
+    largest_resisting : float
+        The largest resisting reduced moment over the turn, ``max(-M_red)``, N m.
+    largest_at : float
+        Where it is, rad in [0, 2 pi) from position 1.
+    motor_declared : bool
+        False when no motor is declared and the constant moment from the cycle balance drives.
+    """
+
+    psi: float
+    t: float
+    initial_speed: float
+    starting_moment: float
+    resisting: float
+    largest_resisting: float
+    largest_at: float
+    motor_declared: bool = True
+
+    @property
+    def turn(self) -> int:
+        """The turn of the crank (from 1) in which the machine stalls."""
+        return int(self.psi // (2 * np.pi)) + 1
+
+    @property
+    def degrees(self) -> float:
+        """The stall's crank angle within its turn, deg in [0, 360) from position 1."""
+        return math.degrees(self.psi % (2 * np.pi))
+
+    @property
+    def shortfall(self) -> float:
+        """How much more driving moment at rest (N m) would make a stall impossible:
+        :attr:`largest_resisting` minus :attr:`starting_moment` (> 0 at any stall)."""
+        return self.largest_resisting - self.starting_moment
+
+    def words(self) -> str:
+        """The stall in one sentence: where (psi, deg, and the turn), when (t, s), the resistance
+        there, the driving moment at rest, and the moment at rest that no start can stall."""
+        start = "from rest" if self.initial_speed == 0 else f"from |omega| = {self.initial_speed:.6g} rad/s"
+        if self.motor_declared:
+            driver = f"the motor's moment at rest is {self.starting_moment:.6g} N m at the crank"
+        else:
+            driver = (f"no [dynamics.motor] is declared, so the constant driving moment from the cycle balance, "
+                      f"{self.starting_moment:.6g} N m, drives it (it gains no energy over a turn, so it cannot "
+                      "bring the machine up to speed)")
+        if self.psi == 0:
+            where = (f"the machine does not start {start}: the starting torque {self.starting_moment:.6g} N m does "
+                     f"not overcome the resisting moment {self.resisting:.6g} N m at the cycle's start (position 1)")
+        else:
+            turn, degrees = self.turn, self.degrees
+            if f"{degrees:.1f}" == "360.0":  # the end of a turn, said as the start of the next
+                turn, degrees = turn + 1, 0.0
+            where = (f"the start-up {start} stalls (omega -> 0) at psi = {degrees:.1f} deg of turn {turn} (psi: the "
+                     f"crank angle from position 1 in the direction of rotation, 0..360 deg) after t = "
+                     f"{self.t:.4g} s, where the resisting reduced moment is {self.resisting:.4g} N m")
+        largest = (f"the largest resisting reduced moment over the turn, {self.largest_resisting:.4g} N m at psi = "
+                   f"{math.degrees(self.largest_at):.1f} deg")
+        if self.motor_declared:
+            more = f" ({self.shortfall:.4g} N m more than this motor's)" if self.shortfall > 0 else ""
+            need = f"no start can stall a machine whose moment at rest exceeds {largest}{more}"
+        else:
+            need = (f"to start it, declare a [dynamics.motor] whose moment at rest exceeds {largest}: no start can "
+                    "stall such a machine")
+        return f"{where}; {driver}; {need}"
+
+
+class StartupStall(DynamicsError):
+    """A start-up transient stalls (omega -> 0): :attr:`stall` says where and why (a
+    :class:`Stall`), :attr:`transient` holds the motion from the start up to the stall (a
+    :class:`Transient`; its one row at t = 0 when the machine does not move)."""
+
+    def __init__(self, message: str, stall: Stall, transient: Transient):
+        super().__init__(message)
+        self.stall, self.transient = stall, transient
 
 
 class _Equation:
@@ -97,6 +197,22 @@ class _Equation:
         self.motor, self.rotation = motor, spec.rotation
         self.cycle, self.constant = cycle, constant
         self.name = mech.name
+        self.motor_declared = spec.motor is not None
+
+    @property
+    def driver(self) -> str:
+        """What drives the machine, in words: the motor, or the constant moment from the cycle balance."""
+        if self.motor_declared:
+            return "the motor"
+        return f"the constant driving moment from the cycle balance ({self.cycle.driving:.6g} N m; no motor declared)"
+
+    def stall(self, psi: float, t: float, initial_speed: float) -> Stall:
+        """The :class:`Stall` at ``psi`` (rad from the start) and ``t`` (s)."""
+        resisting = -self.moment_grid
+        k = int(np.argmax(resisting))
+        return Stall(float(psi), float(t), float(initial_speed), starting_moment(self.motor),
+                     -float(self.moment(psi)), float(resisting[k]), float(self.psi_grid[k] % (2 * np.pi)),
+                     self.motor_declared)
 
     def moment(self, psi):
         return np.interp(np.mod(psi, 2 * np.pi), self.psi_grid, self.moment_grid)
@@ -167,13 +283,15 @@ def _integrate(eq: _Equation, energy0: float, cycles: float, rtol: float, atol: 
     return sol
 
 
-def _raise_events(sol, eq: _Equation, what: str) -> None:
+def _raise_events(sol, eq: _Equation, what: str, stalls: bool = True) -> None:
+    """DynamicsError when the integration failed, the machine runs away or (``stalls``) stalls;
+    with ``stalls=False`` a stall is left to the caller (a start-up: :class:`StartupStall`)."""
     if sol.status == IVP_FAILED:
         raise DynamicsError(f"{what}: the integration failed ({sol.message})")
-    if len(sol.t_events[0]):
+    if stalls and len(sol.t_events[0]):
         psi = sol.t_events[0][0]
         raise DynamicsError(f"{what}: the machine stalls (omega -> 0) at psi = {math.degrees(psi):.1f} deg "
-                            f"after {sol.y_events[0][0][1]:.3g} s: the motor cannot overcome the load")
+                            f"after {sol.y_events[0][0][1]:.3g} s: {eq.driver} cannot overcome the load")
     if len(sol.t_events[1]):
         psi = sol.t_events[1][0]
         raise DynamicsError(f"{what}: the machine runs away (|omega| above the speed limit) at psi = "
@@ -238,10 +356,13 @@ def simulate(mech: Mechanism, spec: DynamicsSpec | None = None, *, initial_speed
         that has no starting torque), ``cycles`` < 1,
         ``rtol`` outside [2.2e-14, 1), ``atol`` <= 0, ``samples`` < 1, ``constant_inertia`` < 0,
         or a declared input out of range.
+    StartupStall
+        A DynamicsError: the machine stalls (omega -> 0; or a start from rest whose starting
+        torque does not overcome the resistance at position 1). It holds the :class:`Stall` (where,
+        when, and the moment at rest no start can stall) and the motion up to it.
     DynamicsError
-        On stall or run-away (or a start from rest whose starting torque does not overcome the
-        resistance at position 1), or when the kinetic energy overflows float64; a mechanism
-        analysed over a partial input range (``range_deg``) has no cycle (DynamicsInputError).
+        On run-away, or when the kinetic energy overflows float64; a mechanism analysed over a
+        partial input range (``range_deg``) has no cycle (DynamicsInputError).
     """
     require_full_turn(mech, "the start-up transient")
     spec = check_spec(dynamics_of(mech) if spec is None else spec)
@@ -261,9 +382,17 @@ def simulate(mech: Mechanism, spec: DynamicsSpec | None = None, *, initial_speed
                           declared=spec.motor is not None)
     energy0 = kinetic_energy(float(eq.inertia(0.0)), w0, f"{name} (initial_speed)")
     sol = _integrate(eq, energy0, cycles or spec.cycles, rtol, atol, limit)
-    _raise_events(sol, eq, name)
+    _raise_events(sol, eq, name, stalls=False)
     w = eq.speed(sol.t, energy0 + sol.y[0])
-    return Transient(sol.t, sol.y[1], spec.rotation * w, sol.sol, sol.message)
+    transient = Transient(sol.t, sol.y[1], spec.rotation * w, sol.sol, sol.message)
+    if len(sol.t_events[0]):
+        _stalled(eq, name, eq.stall(sol.t_events[0][0], sol.y_events[0][0][1], w0), transient)
+    return transient
+
+
+def _stalled(eq: _Equation, name: str, stall: Stall, transient: Transient) -> None:
+    """Raise :class:`StartupStall` for ``stall``, with the motion up to it."""
+    raise StartupStall(f"{name}: {stall.words()}", stall, transient)
 
 
 #: A start from rest is integrated in time over its first REST_START_ANGLE (rad, 1 deg) of input
@@ -289,9 +418,8 @@ def _from_rest(eq: _Equation, spec: DynamicsSpec, cycles: int, rtol: float, atol
     i0 = float(eq.inertia(0.0))
     accel = (starting + resisting) / i0
     if not accel > 0:
-        raise DynamicsError(f"{name}: the machine does not start from rest: the starting torque {starting:.6g} N m "
-                            f"does not overcome the resisting moment {-resisting:.6g} N m at the cycle's start "
-                            "(position 1)")
+        _stalled(eq, name, eq.stall(0.0, 0.0, 0.0),
+                 Transient(np.zeros(1), np.zeros(1), np.zeros(1), None, "does not start"))
     slope = eq.inertia.derivative()
     t_scale = math.sqrt(2 * REST_START_ANGLE / accel)  # time to the switch at the initial acceleration
     w_scale = accel * t_scale
@@ -323,9 +451,10 @@ def _from_rest(eq: _Equation, spec: DynamicsSpec, cycles: int, rtol: float, atol
     if first.status == IVP_FAILED:
         raise DynamicsError(f"{name}: the integration from rest failed ({first.message})")
     if len(first.t_events[1]):
-        raise DynamicsError(f"{name}: the machine stalls (omega -> 0) after {first.t_events[1][0]:.3g} s, within "
-                            f"the first {math.degrees(REST_START_ANGLE):g} deg from rest: the motor cannot "
-                            "overcome the load")
+        psi_stall = float(first.y_events[1][0][0])
+        keep = first.t <= first.t_events[1][0]
+        _stalled(eq, name, eq.stall(psi_stall, first.t_events[1][0], 0.0),
+                 Transient(first.y[0][keep], first.t[keep], spec.rotation * first.y[1][keep], None, "stalled"))
     if len(first.t_events[2]):
         raise DynamicsError(f"{name}: the machine runs away (|omega| above the speed limit) within the first "
                             f"{math.degrees(REST_START_ANGLE):g} deg from rest")
@@ -336,13 +465,16 @@ def _from_rest(eq: _Equation, spec: DynamicsSpec, cycles: int, rtol: float, atol
     psi_switch, w_switch = (float(v) for v in first.y_events[0][0])
     energy = kinetic_energy(float(eq.inertia(psi_switch)), w_switch, name)
     sol = _integrate(eq, energy, cycles, rtol, atol, limit, psi0=psi_switch, t0=t_switch)
-    _raise_events(sol, eq, name)
+    _raise_events(sol, eq, name, stalls=False)
     keep = first.t < t_switch
     psi = np.concatenate([first.y[0][keep], sol.t])
     t = np.concatenate([first.t[keep], sol.y[1]])
     w = np.concatenate([first.y[1][keep], eq.speed(sol.t, energy + sol.y[0])])
-    return Transient(psi, t, spec.rotation * w, _RestStart(first.sol, t_switch, psi_switch, eq, sol.sol),
-                     sol.message)
+    transient = Transient(psi, t, spec.rotation * w, _RestStart(first.sol, t_switch, psi_switch, eq, sol.sol),
+                          sol.message)
+    if len(sol.t_events[0]):
+        _stalled(eq, name, eq.stall(sol.t_events[0][0], sol.y_events[0][0][1], 0.0), transient)
+    return transient
 
 
 class _RestStart:

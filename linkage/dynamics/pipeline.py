@@ -6,7 +6,8 @@ the course method, the exact method or the equation of motion's steady state), t
 kinetostatics under the real motion and the coefficient of dynamics
 ``k_dyn = max|M_b| / |M_d|`` (this project's definition: the peak torque on the drive shaft over
 the mean driving torque). Its :class:`DynamicsReport` also compares the course method with the
-exact one and, with a declared start speed, times the start-up's settling.
+exact one and, with a declared start speed, times the start-up's settling (a start-up that stalls
+is a note saying where and why: the steady state stands without it).
 """
 
 from __future__ import annotations
@@ -30,7 +31,7 @@ from .cycle import (
     fine_cycle,
     speed_fluctuation,
 )
-from .equation import simulate, steady_state
+from .equation import StartupStall, simulate, steady_state
 from .spec import DELTA_RESOLVED, DynamicsSpec, override_spec, require_full_turn
 
 __all__ = ["MEAN_MOMENT_RESOLVED", "DynamicsReport", "run_dynamics"]
@@ -151,7 +152,8 @@ def run_dynamics(mech: Mechanism, method: str = "course", *, positions: int | No
         law = steady_state(mech, spec, constant_inertia=sized and sized.constant_inertia)
         needed = sized and sized.driving_moment
         if spec.initial_speed is not None:
-            comparison = _settling(mech, spec, law)
+            comparison, settling_notes = _settling(mech, spec, law)
+            notes += settling_notes
     if needed is None:
         needed = fine_cycle(mech, spec, FINE_SAMPLES).driving
     _, ends = cycle_positions(mech, spec)
@@ -178,10 +180,17 @@ def _dynamic_coefficient(law: LawOfMotion, balancing: np.ndarray, needed: float)
                   "no net drive",)
 
 
-def _settling(mech: Mechanism, spec: DynamicsSpec, law: LawOfMotion) -> dict[str, Any]:
+def _settling(mech: Mechanism, spec: DynamicsSpec, law: LawOfMotion) -> tuple[dict[str, Any], tuple[str, ...]]:
     """Start-up transient from the declared initial speed: time to come within 1 % of the steady
-    state's mean speed (cycle by cycle)."""
-    transient = simulate(mech, spec, constant_inertia=law.constant_inertia)
+    state's mean speed (cycle by cycle), and notes. A start-up that stalls does not undo the
+    steady state: ``transient_time`` is then the time to the stall, ``settling_time`` None, and a
+    note says where and why it stalls."""
+    try:
+        transient = simulate(mech, spec, constant_inertia=law.constant_inertia)
+    except StartupStall as stalled:
+        return ({"transient_cycles": int(spec.cycles), "transient_time": stalled.stall.t, "settling_time": None},
+                ((f"start-up transient: {stalled.stall.words()}. The steady state does not depend on it: it is "
+                  "the motion of the machine once it runs at speed"),))
     target = abs(law.details["mean_speed"])
     cycle = np.floor(transient.psi / (2 * np.pi)).astype(int)
     settled = None
@@ -191,7 +200,7 @@ def _settling(mech: Mechanism, spec: DynamicsSpec, law: LawOfMotion) -> dict[str
             settled = float(transient.t[cycle == k][0])
             break
     return {"transient_cycles": int(spec.cycles), "transient_time": float(transient.t[-1]),
-            "settling_time": settled}
+            "settling_time": settled}, ()
 
 
 def _course_delta_exactly(spec: DynamicsSpec, law: LawOfMotion, exact: LawOfMotion) -> float:

@@ -137,13 +137,14 @@ class _Work:
         self.report.files.append(name)
 
     def _picture(self, name: str, title: str, build: Callable[[], Any]) -> None:
-        """Save the figure ``build()`` returns as ``name``.png and .svg; an InputError (what the
-        picture needs is missing) becomes a note."""
+        """Save the figure ``build()`` returns as ``name``.png and .svg; a LinkageError (what the
+        picture needs is missing, or its computation fails: no steady state, a run-away) becomes a
+        note, and the report goes on with its other parts."""
         import matplotlib.pyplot as plt
 
         try:
             fig = build()
-        except InputError as exc:
+        except LinkageError as exc:
             self.report.notes.append(f"{title}: left out ({exc})")
             return
         fig = getattr(fig, "figure", fig)  # an Axes -> its Figure
@@ -258,8 +259,10 @@ class _Work:
             self.report.notes.append("start-up from several initial speeds: left out (the scheme declares no "
                                      "[dynamics.motor])")
             return
+        stalls: list[str] = []  # a start-up that stalls is drawn up to the stall, with a note
         self._picture("startup", "Start-up of the machine from several initial speeds",
-                      lambda: machine.plot_startup(self.mech))
+                      lambda: machine.plot_startup(self.mech, notes=stalls))
+        self.report.notes += stalls
 
     def animation(self) -> None:
 

@@ -38,7 +38,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..dynamics.cycle import LawOfMotion, exact_method
-from ..dynamics.equation import simulate, steady_state
+from ..dynamics.equation import StartupStall, simulate, steady_state
 from ..dynamics.motors import starting_moment
 from ..dynamics.pipeline import DynamicsReport
 from ..dynamics.reduced import reduced_characteristics
@@ -489,7 +489,7 @@ def _start_speeds(spec: DynamicsSpec, initial_speeds: Sequence[float] | None) ->
 
 
 def plot_startup(mech: Mechanism, initial_speeds: Sequence[float] | None = None, *, cycles: int | None = None,
-                 constant_inertia: float | None = None) -> Figure:
+                 constant_inertia: float | None = None, notes: list[str] | None = None) -> Figure:
     """The start-up of the machine with its motor: ``|ω|`` against the crank angle travelled.
 
     One curve per initial speed, from the equation of motion with the scheme's motor
@@ -512,12 +512,16 @@ def plot_startup(mech: Mechanism, initial_speeds: Sequence[float] | None = None,
         Constant inertia at the crank, kg·m² (default: the flywheel sized by the exact method for
         the declared δ, as ``linkage dynamics --method ode --transient``; without δ the declared
         one).
+    notes : list of str, optional
+        A start-up that stalls (ω → 0) is drawn up to the stall, marked with a cross, and a note
+        saying where, when and why (:meth:`~linkage.dynamics.equation.Stall.words`) is appended here.
 
     Returns
     -------
     matplotlib Figure
         x: the crank angle travelled from position 1, turns; y: |ω|, rad/s. Curves have gids
-        ``startup:<k>`` in the order of the speeds, the steady mean speed ``steady-mean-speed``.
+        ``startup:<k>`` in the order of the speeds, the steady mean speed ``steady-mean-speed``,
+        the cross at a stall ``stall:<k>``.
 
     Raises
     ------
@@ -526,7 +530,8 @@ def plot_startup(mech: Mechanism, initial_speeds: Sequence[float] | None = None,
         that balances the cycle every speed is its own steady state: there is no start-up), no
         initial speeds, or an argument out of range.
     DynamicsError
-        The machine stalls or runs away, or has no steady state with that motor.
+        The machine runs away, or has no steady state with that motor (a start-up that stalls is
+        drawn up to the stall, with a note).
     PlotExtraMissing
         matplotlib is not installed.
     """
@@ -536,7 +541,7 @@ def plot_startup(mech: Mechanism, initial_speeds: Sequence[float] | None = None,
         raise InputError(f"scheme '{mech.name}' declares no motor ([dynamics.motor]): with a constant driving moment "
                          "that balances the cycle every start speed is its own steady state, so there is no "
                          "start-up to draw: no start-up diagram")
-    speeds, notes = _start_speeds(spec, initial_speeds)
+    speeds, said = _start_speeds(spec, initial_speeds)
     if constant_inertia is None:
         constant, origin = _startup_inertia(mech, spec)
     else:
@@ -546,10 +551,19 @@ def plot_startup(mech: Mechanism, initial_speeds: Sequence[float] | None = None,
     fig = new_figure(FIGURE_WIDTH, 5.6)
     ax = fig.add_subplot()
     for k, w0 in enumerate(speeds):
-        run = simulate(mech, spec, initial_speed=w0, cycles=turns, constant_inertia=constant)
+        colour = CURVE_COLOURS[k % len(CURVE_COLOURS)]
         start = "from rest" if w0 == 0 else f"from |ω| = {w0:.3g} rad/s"
-        ax.plot(run.psi / (2 * np.pi), np.abs(run.omega), "-", lw=1.5, color=CURVE_COLOURS[k % len(CURVE_COLOURS)],
-                label=f"start-up {start}", gid=f"startup:{k}")
+        try:
+            run, ending = simulate(mech, spec, initial_speed=w0, cycles=turns, constant_inertia=constant), ""
+        except StartupStall as stalled:
+            run, stall = stalled.transient, stalled.stall
+            ending = f": stalls (ω → 0) at ψ = {stall.degrees:.1f}° of turn {stall.turn} after {stall.t:.3g} s"
+            ax.plot([stall.psi / (2 * np.pi)], [0.0], "x", ms=9, mew=2, color=colour, clip_on=False, zorder=5,
+                    gid=f"stall:{k}")
+            if notes is not None:
+                notes.append(f"start-up diagram: {stall.words()}")
+        ax.plot(run.psi / (2 * np.pi), np.abs(run.omega), "-", lw=1.5, color=colour,
+                label=f"start-up {start}{ending}", gid=f"startup:{k}")
     ax.axhline(steady, color="black", ls="--", lw=1.2, gid="steady-mean-speed",
                label=f"mean speed of the steady state with this motor: {steady:.4g} rad/s")
     ax.axhline(abs(spec.mean_speed), color="0.5", ls=":", lw=1.2, gid="declared-mean-speed",
@@ -559,7 +573,7 @@ def plot_startup(mech: Mechanism, initial_speeds: Sequence[float] | None = None,
     ax.set_xlabel("crank angle travelled from position 1, turns (360° each)", fontsize=FONT)
     ax.set_ylabel(wrapped_label("angular speed of the crank $|\\omega|$ (magnitude), rad/s", ax), fontsize=FONT)
     ax.set_title(f"start-up of '{mech.name}' with its motor; constant inertia at the crank {constant:.4g} kg·m² "
-                 f"({origin})" + "".join(f"; {note}" for note in notes), fontsize=SMALL, loc="left", wrap=True)
+                 f"({origin})" + "".join(f"; {note}" for note in said), fontsize=SMALL, loc="left", wrap=True)
     fig.legend(*ax.get_legend_handles_labels(), loc="outside lower center", fontsize=SMALL, frameon=False)
     return fig
 
