@@ -5,8 +5,12 @@ A table is an ordered mapping ``name -> 1-D array`` (for analysis results the fi
 ``i``, the position number, and ``phi_deg``). Every command that prints a table (analyze, forces,
 dynamics ...) goes through :func:`format_columns`, so the three formats look the same everywhere:
 
-- ``table``: aligned, right-justified text for people, numbers to 7 significant digits; with
-  ``units``, a second header line gives each column's unit in brackets;
+- ``table``: aligned, right-justified text for people; with ``units``, a second header line gives
+  each column's unit in brackets. Each float column has its own notation (:func:`column_cells`):
+  plain numbers to 7 significant digits (``0.2963995``, ``-172.3759``) when its largest magnitude
+  is between 1e-4 and 1e7, else scientific notation to 7 significant digits (``1.234568e+14``).
+  Only a true 0 prints as ``0``; a value below 1e-12 of its column's largest (round-off, e.g. at a
+  dead centre) prints with 4 (``-8.674e-19``); a missing value prints ``nan``;
 - ``csv``: one header row, numbers at full precision (``repr``, round-trips exactly), ``nan``
   where a value is missing;
 - ``json``: a list of row objects ``{column: value}``; with ``meta``, an object
@@ -44,7 +48,8 @@ import numpy as np
 
 from ..errors import InputError
 
-__all__ = ["FORMATS", "format_columns", "column_unit", "units_of", "select_columns", "table_width", "per_turned_angle"]
+__all__ = ["FORMATS", "format_columns", "column_unit", "units_of", "select_columns", "table_width", "per_turned_angle",
+           "column_cells"]
 
 #: the output formats understood by :func:`format_columns`
 FORMATS = ("table", "csv", "json")
@@ -52,9 +57,17 @@ FORMATS = ("table", "csv", "json")
 #: significant digits of numbers in the human-readable table
 TABLE_DIGITS = 7
 
-#: in the human-readable table, values smaller than this fraction of the table's largest
-#: magnitude are round-off noise around zero and are shown as 0 (CSV and JSON keep them)
+#: values smaller than this fraction of the largest magnitude of their column are round-off around
+#: zero: the table for people shows them with :data:`ROUND_OFF_DIGITS` (never as 0); the answer key
+#: (:mod:`linkage.course.key`) writes them as 0
 TABLE_ZERO = 1e-12
+
+#: significant digits of a round-off value in the human-readable table
+ROUND_OFF_DIGITS = 4
+
+#: a float column whose largest magnitude (to :data:`TABLE_DIGITS`) has a decimal exponent in
+#: this range is written in plain digits (as ``format(x, ".7g")``), any other in scientific notation
+PLAIN_EXPONENTS = range(-4, TABLE_DIGITS)
 
 
 def format_columns(columns: Mapping[str, Any], fmt: str = "table",
@@ -155,24 +168,55 @@ def _json(cols: dict[str, np.ndarray], meta: Mapping[str, Any] | None) -> str:
     return json.dumps(doc, ensure_ascii=False, allow_nan=False)
 
 
-def _human(column: np.ndarray, scale: float) -> list[str]:
+def column_cells(column: Any) -> list[str]:
+    """The texts of one column's values in the table for people, in its own notation.
+
+    A float column is written in plain digits to :data:`TABLE_DIGITS` significant digits when its
+    largest finite magnitude is between 1e-4 and 1e7 (``format(x, ".7g")``: a smaller value of it
+    takes an exponent), else in scientific notation to :data:`TABLE_DIGITS` significant digits for
+    every value, so that its exponents line up. A value below :data:`TABLE_ZERO` of the column's
+    largest magnitude is round-off: it is shown in scientific notation to :data:`ROUND_OFF_DIGITS`
+    significant digits. Only a value equal to 0 is shown as ``0``; NaN as ``nan``, infinities as
+    ``inf``, ``-inf``. Integer, boolean and text columns are shown as they are.
+
+    Parameters
+    ----------
+    column : array_like, shape (N,)
+
+    Returns
+    -------
+    list of str, length N
+
+    >>> column_cells([0.29, -0.0, float("nan"), 3e-19])
+    ['0.29', '0', 'nan', '3.000e-19']
+    >>> column_cells([2.5e14, -1500.0, 1e-3])
+    ['2.500000e+14', '-1.500000e+03', '1.000e-03']
+    """
+    column = np.asarray(column)
     if column.dtype.kind != "f":
         return [str(x) for x in _values(column)]
-    cleaned = np.where(np.abs(column) <= TABLE_ZERO * scale, 0.0, column)
-    return [f"{x:.{TABLE_DIGITS}g}" for x in (cleaned + 0.0).tolist()]  # + 0.0: no "-0"
+    magnitudes = np.abs(column[np.isfinite(column)])
+    largest = float(magnitudes.max()) if magnitudes.size else 0.0
+    plain = largest == 0.0 or _exponent(largest) in PLAIN_EXPONENTS
+    return [_cell(x, largest, plain) for x in _values(column)]
 
 
-def _scale(cols: dict[str, np.ndarray]) -> float:
-    """Largest finite magnitude of the table's float columns."""
-    finite = [np.abs(c[np.isfinite(c)]) for c in cols.values() if c.dtype.kind == "f"]
-    finite = [f for f in finite if f.size]
-    return float(max(f.max() for f in finite)) if finite else 0.0
+def _exponent(x: float) -> int:
+    """Decimal exponent of ``x != 0`` once rounded to :data:`TABLE_DIGITS` significant digits."""
+    return int(f"{x:.{TABLE_DIGITS - 1}e}".partition("e")[2])
+
+
+def _cell(x: float, largest: float, plain: bool) -> str:
+    if x == 0.0 or not math.isfinite(x):
+        return f"{x + 0.0:g}"                                  # 0 (+ 0.0: no "-0"), nan, inf, -inf
+    if abs(x) < TABLE_ZERO * largest:
+        return f"{x:.{ROUND_OFF_DIGITS - 1}e}"
+    return f"{x:.{TABLE_DIGITS}g}" if plain else f"{x:.{TABLE_DIGITS - 1}e}"
 
 
 def _table(cols: dict[str, np.ndarray], meta: Mapping[str, Any] | None,
            units: Mapping[str, str] | None = None) -> str:
-    scale = _scale(cols)
-    cells = {name: _human(c, scale) for name, c in cols.items()}
+    cells = {name: column_cells(c) for name, c in cols.items()}
     heads = {name: f"[{units[name]}]" if units and units.get(name) else "" for name in cols}
     widths = {name: max([len(name), len(heads[name])] + [len(s) for s in cells[name]]) for name in cols}
     lines = [f"# {k}: {v}" for k, v in (meta or {}).items()]
