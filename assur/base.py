@@ -55,6 +55,9 @@ __all__ = [
     "rotate",
     "perp",
     "error_bound",
+    "analog_size",
+    "second_analog_excess",
+    "flag_second_analogs",
     "global_point",
     "point_analogs",
 ]
@@ -76,6 +79,11 @@ COINCIDENT = 1e-9
 ROUNDOFF_FACTOR = 3.0
 #: conditioning below which a group alone cannot keep the guarantee (about 2.6e-4)
 SINGULAR_TOL = float(np.sqrt(ROUNDOFF_FACTOR * np.finfo(float).eps / ANALOG_TOL))
+#: round-off model of a group's first analogs as their error reaches its second analogs through
+#: the quadratic terms, next to a change point: CHANGE_FACTOR * eps / r**2 (see
+#: :func:`second_analog_excess`; measured factor <= 0.03 over the change-point sweeps of
+#: benchmarks/results_guarantee.md and denser ones, 0.2 for a margin)
+CHANGE_FACTOR = 0.2
 
 Poses = Mapping[str, np.ndarray]
 
@@ -124,6 +132,62 @@ def error_bound(ratio: np.ndarray, input_error) -> np.ndarray:
     with np.errstate(divide="ignore", invalid="ignore"):
         own = np.where(ratio > 0, ROUNDOFF_FACTOR * np.finfo(float).eps / ratio**2, np.inf)
         return own + np.where(np.asarray(input_error) > 0, input_error / ratio, 0.0)
+
+
+def analog_size(analogs, scale) -> np.ndarray:
+    """The largest analog ``(N,)`` of some links: the largest of ``|w|`` and ``|v| / scale``
+    (lengths in units of ``scale`` ``(N,)``, m) over ``analogs``, each three columns
+    ``(vx, vy, w)`` of ``(N,)`` (or an ``(N, 3)`` array transposed)."""
+    turn = move = 0.0
+    for vx, vy, w in analogs:
+        turn = np.maximum(turn, np.abs(w))
+        move = np.maximum(move, vx * vx + vy * vy)
+    return np.maximum(turn, np.sqrt(move) / scale)
+
+
+def second_analog_excess(ratio: np.ndarray, input_error, rotation, first_size, second_size) -> np.ndarray:
+    """Bound ``(N,)`` of the relative error a group's second analogs take from the error of its
+    first analogs, which the quadratic terms bring into the second solve amplified by ``1 / r``:
+
+    ``2 A (CHANGE_FACTOR * eps / r**2 + input_error / r) / r``,  ``A = w * min(1, s1 / s2)``
+
+    ``w`` ``(N,)``: the largest rotation analog of the group's links and of the known links that
+    guide its prismatic pairs (the quadratic terms the group's own first analogs enter carry
+    these); ``s1``, ``s2``: the largest first and second analogs of the group and the links it
+    hangs on (:func:`analog_size`). At a toggle the analogs grow like ``1 / r`` and ``1 / r**3``,
+    so ``A ~ r`` and the term stays within the first analogs' bound; next to a change point they
+    stay bounded while ``r`` goes to 0, and the term takes over (docs/numerics.md)."""
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        amplitude = rotation * np.where(second_size > first_size, first_size / second_size, 1.0)
+        first = CHANGE_FACTOR * np.finfo(float).eps / ratio**2 + np.asarray(input_error, float) / ratio
+        return np.where(ratio > 0, 2.0 * amplitude * first / ratio, np.inf)
+
+
+def flag_second_analogs(group: "Group", status, bound, ratio, input_error, scale, first, second, solved):
+    """Statuses and bounds ``(N,)`` of a group once its second analogs are solved.
+
+    At status-OK positions the bound grows by a tenth of :func:`second_analog_excess` (the
+    second analogs are promised ten times ``ANALOG_TOL``); a position whose bound then exceeds
+    ``ANALOG_TOL`` becomes ``SINGULAR``. ``scale``: the group's size ``(N,)``, m; ``first``,
+    ``second``: analogs of every link involved, link -> three columns ``(vx, vy, w)`` of
+    ``(N,)`` (or an ``(N, 3)`` array transposed); ``solved``: the group's analog dicts of
+    ``(N, 3)`` arrays, set to NaN in place where a position is flagged.
+    """
+    guides = {j.a for j in group.joints if j.kind == "P"}
+    rotation = 0.0
+    for link in {*group.links, *(guides & set(group.known_links))}:
+        rotation = np.maximum(rotation, np.abs(first[link][2]))
+    links = (*group.known_links, *group.links)
+    excess = second_analog_excess(ratio, input_error, rotation, analog_size([first[k] for k in links], scale),
+                                  analog_size([second[k] for k in links], scale))
+    ok = status == OK
+    with np.errstate(invalid="ignore"):
+        bound = np.where(ok, bound + excess / 10.0, bound)
+    flagged = ok & ~(bound <= ANALOG_TOL)
+    for values in solved:
+        for v in values.values():
+            v[flagged] = np.nan
+    return np.where(flagged, SINGULAR, status), bound
 
 
 def global_point(pose: np.ndarray, local) -> np.ndarray:
@@ -336,7 +400,8 @@ class GroupSolution(GroupPosition):
     """Result of :meth:`Group.solve`: a :class:`GroupPosition` with the group's analogs.
 
     ``first`` and ``second`` map each of the group's links to ``(N, 3)`` analogs (NaN where the
-    status is not OK), or are ``None`` when not asked for.
+    status is not OK), or are ``None`` when not asked for. Where ``second`` is solved,
+    ``error_bound`` also holds a tenth of the second analogs' own term (:func:`flag_second_analogs`).
     """
 
     first: dict[str, np.ndarray] | None = None
@@ -576,15 +641,21 @@ class Group(ABC):
         version is their oracle.
         """
         placed = self.position(poses, branch, input_error, start)
+        status, bound = placed.status, placed.error_bound
         d1 = d2 = None
         if first is not None:
-            d1, d2 = self.analogs({**poses, **placed.poses}, first, second, valid=placed.status == OK)
+            merged = {**poses, **placed.poses}
+            d1, d2 = self.analogs(merged, first, second, valid=status == OK)
+            if d2 is not None:     # the second analogs' own bound (docs/numerics.md)
+                status, bound = flag_second_analogs(
+                    self, status, bound, placed.conditioning, input_error, self.scale(merged),
+                    {k: v.T for k, v in {**first, **d1}.items()}, {k: v.T for k, v in {**second, **d2}.items()},
+                    (d1, d2))
         if out is not None:
             for into, got in zip(out, (placed.poses, d1, d2)):
                 for link, value in (got or {}).items():
                     into[link][...] = value
-        return GroupSolution(placed.poses, placed.status, placed.jacobian_sign, placed.conditioning,
-                             placed.error_bound, d1, d2)
+        return GroupSolution(placed.poses, status, placed.jacobian_sign, placed.conditioning, bound, d1, d2)
 
     def _split(self, q: np.ndarray) -> dict[str, np.ndarray]:
         return {link: q[:, 3 * i : 3 * i + 3] for i, link in enumerate(self.links)}

@@ -24,6 +24,7 @@ from .base import (
     Joint,
     PrismaticJoint,
     error_bound,
+    flag_second_analogs,
 )
 from .rows import arm, frame, rows_of, xy
 
@@ -93,7 +94,7 @@ class Dyad(Group):
         # the 2x2 system of both analog orders, whose determinant is the group Jacobian's
         c1, c2 = inner.act(l1, ext1.null(l1)), inner.act(l2, ext2.null(l2))
         det = c1[0] * c2[1] - c1[1] * c2[0]
-        ratio = self._conditioning(rows, frames, det)
+        ratio, scale = self._conditioning(rows, frames, det)
         bound = np.where(assembled, error_bound(ratio, input_error), np.inf)
         status = np.where(assembled, np.where(bound <= ANALOG_TOL, OK, SINGULAR), CANNOT_ASSEMBLE)
         sign = np.where(assembled, np.sign(det), 0.0)
@@ -116,6 +117,9 @@ class Dyad(Group):
                     known2 = {k: _columns(second[k]) for k in self.known_links}
                     a1, a2 = self._eliminate(rows, system, known2, gammas)
                     d2 = {l1: _pose_array(a1, bad, into[2], l1), l2: _pose_array(a2, bad, into[2], l2)}
+                    status, bound = flag_second_analogs(self, status, bound, ratio, input_error, scale,
+                                                        {**known, l1: q1, l2: q2}, {**known2, l1: a1, l2: a2},
+                                                        (d1, d2))
         return GroupSolution(new, status, sign, conditioning, bound, d1, d2)
 
     def _eliminate(self, rows, system, known, gammas):
@@ -143,7 +147,8 @@ class Dyad(Group):
 
     def _conditioning(self, rows, frames, det):
         """:meth:`Group.conditioning` elementwise: the Hadamard ratio ``(N,)`` of the scaled
-        Jacobian, from the determinant ``det`` ``(N,)`` of the unscaled one."""
+        Jacobian, from the determinant ``det`` ``(N,)`` of the unscaled one, and the group's
+        scale ``(N,)``, m (:meth:`Group.scale`)."""
         l1, l2 = self.links
         ext1, inner, ext2 = rows
         (ax, ay), (bx, by), (cx, cy) = ext1.contact, inner.contact, ext2.contact
@@ -163,7 +168,7 @@ class Dyad(Group):
             product = product * row0 * row1
         prismatic = sum(r.kind == "P" for r in rows)
         with np.errstate(invalid="ignore"):
-            return np.abs(det) * scale ** (prismatic - 2) / np.sqrt(product)
+            return np.abs(det) * scale ** (prismatic - 2) / np.sqrt(product), scale
 
     # -- reactions: the transposed elimination --------------------------------------------------
     def reactions(self, poses, loads, valid=None, frames=None):
