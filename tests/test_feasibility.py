@@ -169,8 +169,10 @@ def test_non_grashof_four_bar_is_rejected_by_full_rotation_with_the_angles():
     first, last = math.ceil(limit), math.floor(360 - limit)
     assert (first, last) == (88, 272)
     assert verdict.rule == "full_rotation"
-    assert f"cannot be assembled at phi = {first}..{last} deg ({last - first + 1} of 360 input angles" \
-        in verdict.reason
+    # the reason is the turning sentence: the limit angles (refined between the 1 deg steps) and Grashof
+    assert verdict.reason.startswith(f"the input link '1' cannot turn fully: the mechanism assembles only for φ "
+                                     f"from {360 - limit:.2f}° to {limit:.2f}° (through 0°), because the four-bar ")
+    assert "is not a Grashof chain" in verdict.reason and "s + l = 3 m" in verdict.reason
     assert verdict.figures["unassembled_deg"] == [(first, last)]
 
 
@@ -216,7 +218,7 @@ def test_a_singular_position_between_the_angles_is_caught_by_its_branch_warning(
                          .replace("length = 0.076", "length = 0.1"))
     verdict = check(mech, Requirements(positions=360))
     assert verdict.rule == "full_rotation"
-    assert "cannot be assembled at phi = 210, 330 deg (2 of 360" in verdict.reason
+    assert "the mechanism assembles at every φ but 210° and 330°" in verdict.reason
     # 361 angles miss both: the PRP dyad flips assembly mode between two of them
     verdict = check(mech, Requirements(positions=361))
     assert verdict.rule == "no_change_point"

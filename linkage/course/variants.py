@@ -35,7 +35,7 @@ from typing import Any
 
 from ..errors import InputError, LinkageError
 from ..kinematics.feasibility import RULES, Requirements, Verdict, check, parse_requirements
-from ..model.scheme import loads, toml_text
+from ..model.scheme import SECTION_PARSERS, loads, toml_text
 from ..report.results import dynamics_results, forces_results, kinematics_results
 from ..report.tables import format_columns
 from ..report.words import unit_for_people
@@ -288,7 +288,16 @@ def _verdict(template: Template, free: Mapping[str, Any], requirements: Requirem
         text = variant_text(template, "check", free)
     except LinkageError as exc:
         return Verdict(False, "invalid", str(exc).splitlines()[0], {})
-    return check(lambda: loads(text, source=template.source), requirements)
+    verdict = check(lambda: loads(text, source=template.source), requirements)
+    if verdict.rule != "assembles" or verdict.figures:
+        return verdict
+    # refused while being built: its motion is judged first (a crank that cannot turn fully is
+    # rejected by "full_rotation" in those words, not by the [loads] diagram that needs the turn),
+    # on the mechanism alone, without the sections that read its motion ([loads], [dynamics] ...)
+    data = template.scheme_data(free, variant_name(template, "check"))
+    bare = {key: value for key, value in data.items() if key not in SECTION_PARSERS}
+    motion = check(lambda: loads(toml_text(bare), source=template.source), requirements)
+    return verdict if motion.feasible else motion
 
 
 def build_variant(template: Template, variant: Variant) -> dict[str, bytes]:

@@ -22,6 +22,7 @@ from assur.base import NOT_CONVERGED
 
 from ..errors import InputError
 from ..model.mechanism import Mechanism
+from .full_turn import input_cannot_turn
 from .motion import analyze
 
 __all__ = ["Extremes", "NO_STROKE", "extreme_positions", "table_angles", "wrap_angle"]
@@ -141,8 +142,8 @@ def _find_extremes(mech: Mechanism, quantity: str, samples: int, xtol: float) ->
         raise InputError(f"mechanism '{mech.name}' cannot be assembled at any input angle")
     scale = 1.0 if quantity.endswith(".theta") else mech.size  # an angle's analog is in rad/rad
     if not np.nanmax(np.abs(d1)) > 1e-12 * scale:
-        raise InputError(f"'{quantity}' of mechanism '{mech.name}' does not move: it has no extreme "
-                         "positions")
+        raise _first_the_turn(mech, f"'{quantity}' of mechanism '{mech.name}' does not move: it has no extreme "
+                              "positions")
     step = 2 * np.pi / samples
     following = np.roll(d1, -1)  # cyclic: the last interval closes the revolution at 2 pi
     valid = np.isfinite(d1) & np.isfinite(following)
@@ -150,8 +151,8 @@ def _find_extremes(mech: Mechanism, quantity: str, samples: int, xtol: float) ->
     for i in np.flatnonzero(valid & (d1 * following < 0)):
         roots.append(_analog_root(mech, quantity, derivative, grid[i], grid[i] + step, xtol))
     if not roots:
-        raise InputError(f"'{quantity}' of mechanism '{mech.name}' has no extreme position: its first "
-                         "analog does not change sign over a revolution")
+        raise _first_the_turn(mech, f"'{quantity}' of mechanism '{mech.name}' has no extreme position: its first "
+                              "analog does not change sign over a revolution")
     roots = np.mod(roots, 2 * np.pi)
     roots = np.unique(np.where(roots > 2 * np.pi - 1e-12, 0.0, roots))
     values = analyze(mech, roots, order=0, outputs=[quantity]).quantity(quantity)[0]
@@ -160,6 +161,13 @@ def _find_extremes(mech: Mechanism, quantity: str, samples: int, xtol: float) ->
     i_max, i_min = int(np.argmax(values)), int(np.argmin(values))
     return Extremes(quantity, float(roots[i_max]), float(roots[i_min]), float(values[i_max]),
                     float(values[i_min]), roots)
+
+
+def _first_the_turn(mech: Mechanism, refusal: str) -> InputError:
+    """The refusal, told after its cause when the input cannot turn fully (the sweep then misses
+    the angles where the mechanism does not assemble)."""
+    why = input_cannot_turn(mech)
+    return InputError(refusal if why is None else f"{why}; so {refusal}")
 
 
 def _raise_unconverged(mech: Mechanism, grid: np.ndarray, quantity: str, status: np.ndarray) -> None:

@@ -14,7 +14,8 @@ The rules, in the order they are checked (the first that fails is the verdict's 
 
 - ``"assembles"``: the scheme builds, decomposes and assembles at some angle of the travel;
 - ``"full_rotation"``: it assembles at every angle of the travel (a turn, or the declared input
-  range);
+  range); the reason is :func:`~linkage.kinematics.full_turn.input_cannot_turn`'s sentence: where
+  the input can turn and the dimensional reason (Grashof, rod against crank plus offset ...);
 - ``"non_singular"``: no group is singular (status -2) at any angle;
 - ``"no_change_point"``: no group passes a change point (docs/numerics.md), and the analysis
   raises no :class:`~linkage.kinematics.motion.BranchWarning`;
@@ -56,7 +57,8 @@ from assur.base import (
 from ..errors import InputError, LinkageError, SchemeError
 from ..model.mechanism import Mechanism
 from ..structure import structure_of
-from .assembly import CROSSING_STEP, assembly_plans
+from .assembly import assembly_plans
+from .full_turn import cannot_turn_sentence, near_change_points
 from .motion import BranchWarning, Motion, analyze
 
 __all__ = [
@@ -407,7 +409,7 @@ def _judge(mech: Mechanism, req: Requirements, motion: Motion, plans, branch_war
     groups = [repr(g) for g in motion.structure.groups]
     changes = {g: plan.change_points for g, plan in zip(groups, plans) if len(plan.change_points)}
     minima = _transmission_minima(transmission_angles(motion), motion.phi, mech.input_range is None)
-    sweep = _Sweep(mech, req, motion, changes, _near_change_points(motion.phi, changes), branch_warnings,
+    sweep = _Sweep(mech, req, motion, changes, near_change_points(mech, motion.phi), branch_warnings,
                    minima, _stroke(mech, motion))
     figures = _figures(sweep)
     for rule, applies, judge in _RULE_CHECKS:
@@ -437,12 +439,16 @@ def _solved(sweep: _Sweep) -> str | None:
 
 
 def _turns_fully(sweep: _Sweep) -> str | None:
-    phi = sweep.motion.phi
-    failed = (sweep.motion.status == CANNOT_ASSEMBLE) & ~sweep.excused
-    if not failed.any():
-        return None
-    return (f"{sweep.name} cannot be assembled at phi = {_spans_text(sweep.mech, phi, failed)} deg "
-            f"({int(failed.sum())} of {len(phi)} input angles checked over {_travel(sweep.mech)})")
+    """The input cannot turn fully: the words of :func:`~.full_turn.input_cannot_turn` (where the
+    mechanism assembles and the dimensional reason) for the angles of this sweep."""
+    failed = _stops(sweep)
+    return cannot_turn_sentence(sweep.motion, failed) if failed.any() else None
+
+
+def _stops(sweep: _Sweep) -> np.ndarray:
+    """``(N,)`` bool: the angles of the sweep where the mechanism cannot be assembled (those at a
+    change point excused)."""
+    return (sweep.motion.status == CANNOT_ASSEMBLE) & ~sweep.excused
 
 
 def _stays_regular(sweep: _Sweep) -> str | None:
@@ -484,8 +490,10 @@ def _stroke_within_bounds(sweep: _Sweep) -> str | None:
     if output is None:
         return f"{sweep.name} declares no output, so its stroke cannot be checked against [{low:g}, {high:g}]"
     if sweep.stroke is None:
-        return (f"the stroke of {output.quantity} cannot be measured: {sweep.name} does not assemble over "
-                "its whole travel")
+        failed = _stops(sweep)
+        why = cannot_turn_sentence(sweep.motion, failed) if failed.any() else \
+            f"{sweep.name} does not assemble over its whole travel"
+        return f"the stroke of {output.quantity} cannot be measured: {why}"
     unit = _unit(output.quantity)
     if low <= sweep.stroke <= high:
         return None
@@ -521,18 +529,6 @@ def _travel(mech: Mechanism) -> str:
 
 def _unit(quantity: str) -> str:
     return "rad" if quantity.endswith(".theta") else "m"
-
-
-def _near_change_points(phi: np.ndarray, changes: dict) -> np.ndarray:
-    """``(N,)`` bool: input angles within one sweep step (at least ``CROSSING_STEP``) of a change
-    point of any group (angles compared modulo a turn)."""
-    near = np.zeros(len(phi), bool)
-    if not changes or len(phi) < 2:
-        return near
-    window = max(float(np.max(np.abs(np.diff(phi)))), CROSSING_STEP) * (1 + 1e-9)
-    points = np.concatenate(list(changes.values()))
-    gap = np.abs((phi[:, None] - points[None, :] + np.pi) % TWO_PI - np.pi)
-    return np.any(gap <= window, axis=1)
 
 
 def _worst_group(motion: Motion, where: np.ndarray) -> tuple[str, float]:

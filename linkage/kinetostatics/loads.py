@@ -53,6 +53,7 @@ from assur.base import cross, point_analogs
 
 from ..errors import InputError, LinkageError, SchemeError
 from ..kinematics.extremes import extreme_positions, table_angles, wrap_angle
+from ..kinematics.full_turn import input_cannot_turn
 from ..kinematics.motion import Motion, input_sweep, parse_quantity
 from ..model.mechanism import Mechanism
 from ..model.numbers import angle_from, check_number, unknown_keys
@@ -376,7 +377,7 @@ def _diagram(mech: Mechanism, raw: Any, quantity: str | None, where: str, proble
 
         try:
             parse_quantity(mech, quantity)
-        except (LinkageError, ValueError, KeyError) as exc:
+        except LinkageError as exc:
             problems.append(f"{where}: diagram quantity {quantity!r}: {exc}")
             return None
     raw_working = raw.get("working")
@@ -413,7 +414,7 @@ def _diagram(mech: Mechanism, raw: Any, quantity: str | None, where: str, proble
         return None
     try:
         ext = extreme_positions(mech, quantity)
-    except (LinkageError, ValueError) as exc:
+    except LinkageError as exc:
         problems.append(f"{where}: {exc}")
         return None
     if not ext.moves(mech.size):
@@ -457,7 +458,7 @@ def _cycle_table(mech: Mechanism, spec, quantity: str, where: str, problems: lis
         return None
     try:
         phi0 = float(table_angles(mech, 1, dyn.start, dyn.rotation)[0])
-    except (LinkageError, ValueError) as exc:
+    except LinkageError as exc:
         problems.append(f"{where}: the cycle's first position: {exc}")
         return None
     return CycleTable(quantity, values, dyn.start, dyn.rotation, phi0)
@@ -601,7 +602,8 @@ def parse_loads(mech: Mechanism, raw: Mapping[str, Any] | None) -> tuple[Loads, 
     """Loads and the list of problems from a scheme's ``[loads]`` table.
 
     Every number is checked against its range (``schemes/README.md``, "Ranges"); the stroke ends
-    of force diagrams and the first position of cycle tables are found here, once.
+    of force diagrams and the first position of cycle tables are found here, once: when the input
+    cannot turn fully, they are refused first in the words of :func:`~linkage.kinematics.full_turn.input_cannot_turn`.
     """
     problems: list[str] = []
     raw = {} if raw is None else raw
@@ -612,6 +614,14 @@ def parse_loads(mech: Mechanism, raw: Mapping[str, Any] | None) -> tuple[Loads, 
     if "gravity" in raw:
         g = _numbers(raw["gravity"], "gravity", "[gx, gy]", problems, "real", "m/s^2", length=2)
         gravity = g if g is not None else gravity
+    # a diagram over the working stroke or a cycle table needs the whole turn: first, can the input make it?
+    cyclic = [f"{key}[{i}] ({what} {spec.get(what)!r})" for key, what in (("forces", "point"), ("moments", "link"))
+              for i, spec in enumerate(raw[key] if isinstance(raw.get(key), list) else [])
+              if isinstance(spec, Mapping) and ("diagram" in spec or "cycle" in spec)]
+    why = input_cannot_turn(mech) if cyclic else None
+    if why:
+        return Loads(gravity), problems + [f"{why}; {', '.join(cyclic)} cannot follow the working cycle: a diagram "
+                                           "over the stroke or a cycle table needs the whole travel of the input"]
     forces, moments = [], []
     for i, spec in enumerate(_entries(raw, "forces", problems)):
         where = f"forces[{i}]"
