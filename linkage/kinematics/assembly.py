@@ -32,6 +32,7 @@ from ..model.mechanism import Mechanism
 from ..structure import Structure, structure_of
 from .inputs import input_poses
 from .tracing import finite_poses, trace_modes, track_of
+from .turning import turning_reason
 
 __all__ = ["BranchPlan", "assembly_plans", "assembly_branches", "place_group", "BRANCH_SWEEP"]
 
@@ -199,35 +200,50 @@ def assembly_plans(mech: Mechanism) -> tuple[BranchPlan, ...]:
         phi = np.linspace(*mech.input_range, BRANCH_SWEEP)
     poses = input_poses(mech, structure, phi)
     plans: list[BranchPlan] = []
+    assembled: dict[int, np.ndarray] = {}       # group -> where it assembles on the sweep (M,)
     for i, group in enumerate(structure.groups):
-        rule = rules.get(i)
-        if getattr(group, "tracked", False):
-            plan = _traced_plan(mech, structure, plans, i, rule, poses, phi)
-            plans.append(plan)
-            poses.update(place_group(group, poses, 1, start=plan.start(phi)).poses)
-            continue
-        mode = rule.mode if rule is not None else "keep"
-        # the first branch's placement: both branches of a closed form assemble at the same angles
-        first = group.position(poses, group.branches[0])
-        if np.all(first.status == CANNOT_ASSEMBLE):
-            _narrow_window(mech, structure, plans, i, phi, poses)
-            _never_assembles(mech, structure, plans, i, phi, poses)
-        if len(group.branches) == 1:
-            plan = BranchPlan(1, "keep", np.empty(0), np.empty(0, bool), period=mech.coordinate.period)
-        else:
-            changes, swaps = _change_points(mech, structure, plans, i, phi, first.conditioning)
-            candidates = {m: BranchPlan(m, mode, changes, swaps, period=mech.coordinate.period)
-                          for m in group.branches}
-            if rule is not None and rule.phi is not None:
-                at = np.array([rule.phi])
-                chosen = _choose(mech, group, rule, candidates, _chain(mech, structure, plans, i, at), at)
-            else:
-                chosen = _choose(mech, group, rule, candidates, poses, phi)
-            plan = candidates[chosen]
+        try:
+            plan = _plan(mech, structure, plans, i, rules.get(i), poses, phi, assembled)
+        except SchemeError as exc:
+            raise _first_cause(mech, structure, poses, phi, assembled, exc) from None
         plans.append(plan)
-        poses.update(place_group(group, poses, plan.branches(phi)).poses)
+        poses.update(place_group(group, poses, plan.branches(phi), start=plan.start(phi)).poses)
     cache["plans"] = tuple(plans)
     return cache["plans"]
+
+
+def _plan(mech, structure, plans, i, rule, poses, phi, assembled) -> BranchPlan:
+    """The branch plan of group ``i`` (earlier groups placed in ``poses`` at the sweep ``phi``);
+    records in ``assembled[i]`` where the group assembles."""
+    group = structure.groups[i]
+    if getattr(group, "tracked", False):
+        return _traced_plan(mech, structure, plans, i, rule, poses, phi, assembled)
+    mode = rule.mode if rule is not None else "keep"
+    # the first branch's placement: both branches of a closed form assemble at the same angles
+    first = group.position(poses, group.branches[0])
+    assembled[i] = first.status != CANNOT_ASSEMBLE
+    if not assembled[i].any():
+        _narrow_window(mech, structure, plans, i, phi, poses)
+        _never_assembles(mech, structure, plans, i, phi, poses)
+    if len(group.branches) == 1:
+        return BranchPlan(1, "keep", np.empty(0), np.empty(0, bool), period=mech.coordinate.period)
+    changes, swaps = _change_points(mech, structure, plans, i, phi, first.conditioning)
+    candidates = {m: BranchPlan(m, mode, changes, swaps, period=mech.coordinate.period) for m in group.branches}
+    if rule is not None and rule.phi is not None:
+        at = np.array([rule.phi])
+        return candidates[_choose(mech, group, rule, candidates, _chain(mech, structure, plans, i, at), at)]
+    return candidates[_choose(mech, group, rule, candidates, poses, phi)]
+
+
+def _first_cause(mech, structure, poses, phi, assembled, exc: SchemeError) -> SchemeError:
+    """``exc`` with the reason a person checks first put before it: when a group up to the one
+    refused does not assemble over the whole sweep, the input cannot turn fully
+    (:func:`~.turning.turning_reason`: where it assembles, and why not)."""
+    for j, where in assembled.items():
+        if where.any() and not where.all():
+            sentence = turning_reason(mech, structure.groups[j], poses, phi, where)
+            return SchemeError([f"mechanism '{mech.name}': {sentence}", *exc.problems])
+    return exc
 
 
 def assembly_branches(mech: Mechanism) -> tuple[int, ...]:
@@ -386,7 +402,7 @@ def _rule_score(mech: Mechanism, rule, poses) -> np.ndarray:
 # ----------------------------------------------------------------------------------------------
 
 
-def _traced_plan(mech, structure, plans, i, rule, poses, phi) -> BranchPlan:
+def _traced_plan(mech, structure, plans, i, rule, poses, phi, assembled) -> BranchPlan:
     """The plan of a group solved by Newton's method: its assembly modes found over the sweep and
     each followed over it (:func:`linkage.kinematics.tracing.trace_modes`); the declared condition
     chooses one (:func:`_chosen_trace`); the change points where the chosen mode meets another
@@ -400,6 +416,7 @@ def _traced_plan(mech, structure, plans, i, rule, poses, phi) -> BranchPlan:
 
     periodic = mech.input_range is None
     traces = trace_modes(group, phi, known, known_at, periodic)
+    assembled[i] = np.any([finite_poses(t.rows) for t in traces], axis=0) if traces else np.zeros(len(phi), bool)
     if not traces:
         _never_assembles(mech, structure, plans, i, phi, known)
     chosen = traces[_chosen_trace(mech, group, rule, traces, poses, phi)]
