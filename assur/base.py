@@ -126,11 +126,12 @@ def angle_of(v: np.ndarray) -> np.ndarray:
     return np.arctan2(v[..., 1], v[..., 0])
 
 
-def error_bound(ratio: np.ndarray, input_error) -> np.ndarray:
+def error_bound(ratio: np.ndarray, input_error, factor: float = ROUNDOFF_FACTOR) -> np.ndarray:
     """Bound ``(N,)`` of the relative error of a group's first analogs for its conditioning
-    ``ratio``: ``ROUNDOFF_FACTOR * eps / r**2 + input_error / r`` (inf where r = 0)."""
+    ``ratio``: ``factor * eps / r**2 + input_error / r`` (inf where r = 0); ``factor``: the
+    kind's round-off factor (:attr:`Group.roundoff_factor`)."""
     with np.errstate(divide="ignore", invalid="ignore"):
-        own = np.where(ratio > 0, ROUNDOFF_FACTOR * np.finfo(float).eps / ratio**2, np.inf)
+        own = np.where(ratio > 0, factor * np.finfo(float).eps / ratio**2, np.inf)
         return own + np.where(np.asarray(input_error) > 0, input_error / ratio, 0.0)
 
 
@@ -424,6 +425,14 @@ class Group(ABC):
     kind: ClassVar[str] = ""
     group_class: ClassVar[str] = "II"
     branches: ClassVar[tuple[int, ...]] = (1,)
+    #: the kind's round-off model: its first analogs' relative error <= roundoff_factor * eps / r**2
+    #: for its :meth:`conditioning` r (calibrated per measure against 50-digit references)
+    roundoff_factor: ClassVar[float] = ROUNDOFF_FACTOR
+
+    @property
+    def singular_tol(self) -> float:
+        """Conditioning below which the group alone cannot keep the guarantee."""
+        return float(np.sqrt(self.roundoff_factor * np.finfo(float).eps / ANALOG_TOL))
 
     def __init__(self, links: Sequence[str], joints: Sequence[Joint], size: float = 1.0):
         self.links = tuple(links)
@@ -451,7 +460,7 @@ class Group(ABC):
         """Poses of the group's links given the known ``poses``; checks closure and singularity.
 
         A position is singular (status -2) where the bound of the relative error of the first
-        analogs, ``ROUNDOFF_FACTOR * eps / r**2 + input_error / r`` for the group's
+        analogs, ``roundoff_factor * eps / r**2 + input_error / r`` for the group's
         :meth:`conditioning` r, exceeds ``ANALOG_TOL``: the group's own round-off plus the error
         of the known links' analogs (``input_error``, scalar or ``(N,)``) amplified by the solve.
         ``start``: poses of the group's links near the wanted solution, for kinds solved
@@ -478,7 +487,7 @@ class Group(ABC):
             sign[assembled] = det_sign
             conditioning[assembled] = ratio
             incoming = np.broadcast_to(np.asarray(input_error, float), status.shape)[assembled]
-            bound[assembled] = error_bound(ratio, incoming)
+            bound[assembled] = error_bound(ratio, incoming, self.roundoff_factor)
             status[assembled & ~(bound <= ANALOG_TOL)] = SINGULAR
         for k in new:
             new[k] = np.where(assembled[:, None], new[k], np.nan)
@@ -583,6 +592,16 @@ class Group(ABC):
         sign : ndarray, shape (N,)
             Sign of ``det(phi_q)``.
         """
+        scaled = self.scaled_jacobian(phi_q, poses)
+        det = np.linalg.det(scaled)
+        norms = np.prod(np.linalg.norm(scaled, axis=2), axis=1)
+        return np.abs(det) / np.where(norms > 0, norms, 1.0), np.sign(det)
+
+    def scaled_jacobian(self, phi_q: np.ndarray, poses: Poses) -> np.ndarray:
+        """The group Jacobian ``(N, m, m)`` made dimensionless at the group's own scale ``L``
+        (:meth:`scale`): each link's rotation column taken about the centroid of that link's
+        contact points (a column operation that leaves the determinant unchanged) and divided by
+        ``L``, the angle rows of prismatic pairs multiplied by ``L``."""
         contacts = self.contact_points(poses)                          # (N, J, 2)
         scale = self.scale(poses, contacts)[:, None, None]
         scaled = phi_q.copy()
@@ -594,9 +613,7 @@ class Group(ABC):
             scaled[:, :, c + 2:c + 3] /= scale
         angle_rows = [rows.start + 1 for rows, j in zip(self.joint_rows, self.joints) if isinstance(j, PrismaticJoint)]
         scaled[:, angle_rows, :] *= scale
-        det = np.linalg.det(scaled)
-        norms = np.prod(np.linalg.norm(scaled, axis=2), axis=1)
-        return np.abs(det) / np.where(norms > 0, norms, 1.0), np.sign(det)
+        return scaled
 
     # -- analogs -------------------------------------------------------------------------------
     def analogs(self, poses: Poses, first: Poses, second: Poses | None = None, valid=None):
@@ -612,7 +629,7 @@ class Group(ABC):
             ratio = np.zeros(len(ok))
             if ok.any():
                 ratio[ok] = self.conditioning(phi_q[ok], {k: v[ok] for k, v in poses.items()})[0]
-            ok &= ratio >= SINGULAR_TOL
+            ok &= ratio >= self.singular_tol
         else:
             ok &= np.asarray(valid, bool)
         phi_q[~ok] = np.eye(phi_q.shape[1])

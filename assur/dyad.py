@@ -95,7 +95,7 @@ class Dyad(Group):
         c1, c2 = inner.act(l1, ext1.null(l1)), inner.act(l2, ext2.null(l2))
         det = c1[0] * c2[1] - c1[1] * c2[0]
         ratio, scale = self._conditioning(rows, frames, det)
-        bound = np.where(assembled, error_bound(ratio, input_error), np.inf)
+        bound = np.where(assembled, error_bound(ratio, input_error, self.roundoff_factor), np.inf)
         status = np.where(assembled, np.where(bound <= ANALOG_TOL, OK, SINGULAR), CANNOT_ASSEMBLE)
         sign = np.where(assembled, np.sign(det), 0.0)
         conditioning = np.where(assembled, ratio, np.nan)

@@ -20,7 +20,7 @@ import numpy as np
 
 from .base import CANNOT_ASSEMBLE, NOT_CONVERGED, OK, SINGULAR, Group, GroupPosition, Poses
 
-__all__ = ["NewtonGroup", "NEWTON_STEPS", "TRACE_JUMP", "newton", "group_class_of"]
+__all__ = ["NewtonGroup", "NEWTON_STEPS", "TRACE_JUMP", "GROUP_ROUNDOFF_FACTOR", "newton", "group_class_of"]
 
 #: most Newton steps per solve
 NEWTON_STEPS = 40
@@ -30,6 +30,12 @@ STEP_TOL = 1e-13
 #: weighted by the size) is another assembly mode, not the start's: a traced mode moves less than
 #: this between two samples of its trace
 TRACE_JUMP = 0.1
+#: round-off model of the first analogs of a group solved here: relative error <= GROUP_ROUNDOFF_FACTOR *
+#: eps / r**2 for its conditioning r = sigma_min / sigma_max (:meth:`NewtonGroup.conditioning`); measured
+#: factor <= 0.061 over 480 random triads (RRR legs, a slider on a leg, a slot; regular and 1e-1 .. 1e-8
+#: rad from singular) against 50-digit references (benchmarks/bench_guarantee_groups.py, results in
+#: benchmarks/results_guarantee_groups.md); about ten times that for a margin
+GROUP_ROUNDOFF_FACTOR = 0.6
 
 
 def group_class_of(links, joints) -> str:
@@ -138,6 +144,7 @@ class NewtonGroup(Group):
 
     kind = "N"
     tracked = True      # its assembly plan traces its modes over a sweep and gives starts
+    roundoff_factor = GROUP_ROUNDOFF_FACTOR     # for its conditioning sigma_min / sigma_max
 
     def __init__(self, links, joints, size=1.0):
         super().__init__(links, joints, size)
@@ -152,6 +159,40 @@ class NewtonGroup(Group):
     def __repr__(self) -> str:
         return f"{self.group_class}({','.join(sorted(self.links, key=_natural))})"
 
+    def conditioning(self, phi_q: np.ndarray, poses: Poses) -> tuple[np.ndarray, np.ndarray]:
+        """The group's distance to a singular position, scale-free, and the sign of its Jacobian's
+        determinant.
+
+        The ratio ``sigma_min / sigma_max`` of the singular values of the group Jacobian made
+        dimensionless at the group's own scale as in :meth:`Group.conditioning` (rotations about
+        the middle of each link's pairs, lengths in units of the largest distance between the
+        group's pair points), each row then divided by its norm (the measure does not depend on how
+        an equation is written). It is the inverse condition number of that Jacobian: 1 for
+        orthogonal rows, 0 at a singular position, and it falls in proportion to the distance
+        from one. The Hadamard ratio of the dyads is the product of all the singular values: for a
+        12 x 12 Jacobian it is small at a well-proportioned position too (1e-3 for
+        ``six_bar_class3``), this is not (0.01 .. 0.1).
+
+        Parameters
+        ----------
+        phi_q : ndarray, shape (N, m, m)
+            The group Jacobian (:meth:`Group.jacobians`).
+        poses : dict
+            Poses ``(N, 3)`` of the group's and known links.
+
+        Returns
+        -------
+        ratio : ndarray, shape (N,)
+            The conditioning in [0, 1].
+        sign : ndarray, shape (N,)
+            Sign of ``det(phi_q)``.
+        """
+        scaled = self.scaled_jacobian(phi_q, poses)
+        norms = np.linalg.norm(scaled, axis=2, keepdims=True)
+        values = np.linalg.svd(scaled / np.where(norms > 0, norms, 1.0), compute_uv=False)
+        ratio = values[:, -1] / np.where(values[:, 0] > 0, values[:, 0], 1.0)
+        return ratio, np.linalg.slogdet(phi_q)[0]
+
     def modes(self, poses: Poses):
         """Hook: every assembly mode at each position, ``({link: (N, K, 3)}, valid (N, K))``, or
         ``None`` when the kind cannot list them (the plan then finds them by Newton's method from
@@ -162,8 +203,10 @@ class NewtonGroup(Group):
         """:meth:`Group.position` from ``start`` (the poses of the group's links near the wanted
         assembly mode, ``(N, 3)`` each).
 
-        Where the kind lists its modes, the listed solution nearest to the start is polished. The
-        position is singular (-2) when a second listed mode is nearly as near (the start cannot
+        The singular check is :meth:`Group.position`'s with this kind's error model,
+        its round-off factor :data:`GROUP_ROUNDOFF_FACTOR` for the conditioning :meth:`conditioning`. Where the kind lists
+        its modes, the listed solution nearest to the start is polished. The position is also
+        singular (-2) when a second listed mode is nearly as near (the start cannot
         tell them apart), or when no listed mode lies within :data:`TRACE_JUMP` of the size (the
         listing lost the start's mode, as it does next to a position where two modes meet; Newton's
         method then runs from the start itself). Statuses beyond :meth:`Group.position`'s:
@@ -184,8 +227,8 @@ class NewtonGroup(Group):
         with np.errstate(invalid="ignore"):
             wandered = _distance(self, solved, start) > TRACE_JUMP * size
         placed = self._checked(poses, solved, _finite_rows(solved) & ~wandered, input_error)
-        started = _finite_rows(start) & _finite_rows({k: poses[k] for k in self.known_links})
         status = placed.status.copy()
+        started = _finite_rows(start) & _finite_rows({k: poses[k] for k in self.known_links})
         status[(status == OK) & ~converged] = NOT_CONVERGED
         status[started & (status == CANNOT_ASSEMBLE)] = NOT_CONVERGED
         status[ambiguous & (status == OK)] = SINGULAR
