@@ -10,7 +10,8 @@ solvers (package :mod:`assur`) give positions and exact transfer functions
 """
 
 from . import dynamics, kinetostatics  # noqa: F401  (register the [loads] and [dynamics] sections)
-from .errors import AssemblyError, ConvergenceError, InputError, LinkageError, SchemeError, StructureError
+from .errors import (AssemblyError, ConvergenceError, InputError, LinkageError, PlausibilityWarning, SchemeError,
+                     StructureError)
 from .kinematics import VariantMotion, analyze, analyze_variants, extreme_positions, geometry_of, table_angles
 from .kinematics.motion import Motion
 from .model import InputLaw, Mechanism, MechanismBuilder, dumps, load, loads, save, shipped_schemes
@@ -18,7 +19,8 @@ from .structure import decompose, mobility, structure_of
 from .version import __version__
 
 __all__ = [
-    "AssemblyError", "ConvergenceError", "InputError", "LinkageError", "SchemeError", "StructureError", "InputLaw",
+    "AssemblyError", "ConvergenceError", "InputError", "LinkageError", "PlausibilityWarning", "SchemeError",
+    "StructureError", "InputLaw",
     "Mechanism", "MechanismBuilder", "Motion", "VariantMotion", "analyze", "analyze_variants", "decompose",
     "geometry_of", "dumps", "extreme_positions", "load",
     "loads", "mobility", "save", "shipped_schemes", "structure_of", "table_angles", "__version__",

@@ -13,12 +13,15 @@
 
 :class:`SchemeError` and :class:`InputError` are also ``ValueError`` s, so code that catches
 ``ValueError`` keeps working.
+
+One warning lives here too: :class:`PlausibilityWarning`, a scheme that is valid but almost never
+meant (lengths typed in mm, gravity pointing up ...; :mod:`linkage.model.plausibility`).
 """
 
 from __future__ import annotations
 
 __all__ = ["LinkageError", "SchemeError", "StructureError", "AssemblyError", "ConvergenceError", "InputError",
-           "DynamicsError", "DynamicsInputError"]
+           "DynamicsError", "DynamicsInputError", "PlausibilityWarning"]
 
 
 class LinkageError(Exception):
@@ -99,3 +102,11 @@ class DynamicsError(LinkageError):
 
 class DynamicsInputError(DynamicsError, InputError):
     """An argument of a dynamics function is out of range; the message names it and its value."""
+
+
+class PlausibilityWarning(UserWarning):
+    """A scheme's value is valid but almost never meant: a length over 50 m (typed in mm?),
+    masses out of scale with the lengths, gravity pointing up, radians typed into ``*_deg``
+    keys, a speed over 10000 rpm (:mod:`linkage.model.plausibility`). The message names the
+    file, the key and how to silence it: ``[checks] silence = ["lengths", ...]`` in the scheme,
+    or ``warnings.filterwarnings("ignore", category=linkage.PlausibilityWarning)`` in Python."""

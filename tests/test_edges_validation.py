@@ -186,6 +186,7 @@ def test_a_machine_at_the_edge_of_the_ranges_loads_and_analyses(k):
             spec["mass"] = 1.0
     data["loads"] = {"moments": [{"link": "3", "diagram": {"working": "+", "fractions": [0, 1],
                                                            "values": [1.0, 1.0]}}]}
+    data["checks"] = {"silence": ["lengths", "masses"]}  # meant: no plausibility note (1e45 m links)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         mech = linkage.loads(linkage.dumps(from_dict(data)), source=f"four_bar_x{k:g}")
@@ -291,7 +292,7 @@ def test_bad_dynamics_and_a_cycle_table_that_needs_it_are_one_message(tmp_path):
 
 def test_loads_and_dynamics_are_parsed_once_at_load_time(monkeypatch):
     mech = linkage.load("course_slider_crank")
-    assert set(mech.parts) == {"loads", "dynamics"}
+    assert set(mech.parts) == {"loads", "dynamics", "checks"}
     loads, spec = loads_of(mech), dynamics_of(mech)
     calls = []
     for section in ("loads", "dynamics"):

@@ -27,7 +27,7 @@ Each mutant, written to a file of its own name, either
    ``on_failure="mask"``, the kinetostatics of its loads (``solve_reactions``) and, when it
    declares a ``delta``, Mertsalov's course method raise nothing but
    :class:`linkage.LinkageError` subclasses, and no numpy warning (every warning is an error
-   here, except the library's own ``BranchWarning``); statuses are 0, -1 or -2; at status-0
+   here, except the library's own ``BranchWarning`` and ``PlausibilityWarning``); statuses are 0, -1 or -2; at status-0
    positions the analogs and the balancing moment are finite and every pair closes: a revolute
    pair's two copies of its point coincide, a prismatic pair's slider point lies on its guide
    and the relative angle is the declared one, to ``CLOSURE_TOL`` x the size of the positions.
@@ -51,7 +51,7 @@ import pytest
 
 import linkage
 from assur.base import OK, global_point
-from linkage import LinkageError, SchemeError
+from linkage import LinkageError, PlausibilityWarning, SchemeError
 from linkage.dynamics.cycle import course_method
 from linkage.kinematics.motion import BranchWarning
 from linkage.kinetostatics.reactions import solve_reactions
@@ -329,6 +329,7 @@ def run_mutant(m: Mutant, path: Path) -> tuple[str, str | None]:
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         warnings.simplefilter("ignore", BranchWarning)
+        warnings.simplefilter("ignore", PlausibilityWarning)  # a valid value seldom meant (gravity up): a note
         try:
             mech = linkage.load(path)
         except SchemeError as exc:

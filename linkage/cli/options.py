@@ -30,6 +30,7 @@ from ..dynamics.motors import RPM
 from ..errors import InputError, SchemeError
 from ..model.input_laws import InputLaw, table_problems
 from ..model.numbers import MAX_ANGLE_DEG, MAX_MAGNITUDE, MAX_POSITIONS
+from ..model.plausibility import warn_fast_speed
 from ..model.scheme import load, section_of
 from ..report import FORMATS, format_columns
 from ..report.results import JSON_CONVENTIONS, InputRange
@@ -404,7 +405,10 @@ def input_speed(args, mech=None) -> float | None:
         if mech is not None and not mech.coordinate.is_angle:
             raise InputError(f"--rpm {args.rpm:g}: scheme '{mech.name}' is driven by a slide (input "
                              f"'{mech.inputs[0]}'), whose speed is in m/s: give --omega M_S (the slide's speed)")
+        warn_fast_speed(f"--rpm {args.rpm:g}", args.rpm * RPM, mech)
         return args.rpm * RPM
+    if args.omega is not None:
+        warn_fast_speed(f"--omega {args.omega:g}", args.omega, mech)
     return args.omega
 
 

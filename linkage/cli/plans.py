@@ -67,7 +67,7 @@ def run(args: argparse.Namespace) -> int:
     for option, value in (("--mu-v", args.mu_v), ("--mu-a", args.mu_a), ("--mu-f", args.mu_f)):
         if value is not None and value <= 0:
             raise InputError(f"{option} {value:g}: a scale must be positive (units per mm)")
-    omega, spec = input_speed(args), declared_dynamics(mech)
+    omega, spec = input_speed(args, mech), declared_dynamics(mech)
     if omega is None and spec is not None:
         omega = spec.mean_speed
     notes = []

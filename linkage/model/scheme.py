@@ -23,6 +23,7 @@ from ..errors import SchemeError
 from .builder import MechanismBuilder
 from .mechanism import Mechanism, Prismatic, Revolute
 from .numbers import MAX_ANGLE_DEG, MAX_MAGNITUDE, angle_from, is_number, unknown_keys
+from .plausibility import parse_checks, warn_implausible
 
 __all__ = ["load", "loads", "dumps", "save", "shipped_schemes", "scheme_path", "section_of",
            "register_section", "register_check", "SECTION_PARSERS", "LOAD_CHECKS"]
@@ -74,6 +75,10 @@ def register_section(name: str, parser: Callable[[Mechanism, Any], tuple[Any, li
     """
     SECTION_PARSERS[name] = parser
     _REQUIRES[name] = tuple(requires)
+
+
+#: ``[checks] silence = [...]``: the plausibility notes a scheme silences (:mod:`.plausibility`)
+register_section("checks", parse_checks)
 
 
 def _section_order() -> list[str]:
@@ -190,6 +195,7 @@ def loads(text: str, source: str = "<string>", default_name: str = "mechanism") 
         mech = from_dict(data, default_name)
     except SchemeError as exc:
         raise SchemeError([f"{source}: {p}" for p in exc.problems]) from None
+    warn_implausible(data, mech, source)  # valid, but almost never meant: a note naming the key
     return mech
 
 
