@@ -13,7 +13,7 @@ exist on a sweep of the input and follows each one over it:
   to :data:`REFINEMENTS` times (:func:`_refine`);
 - where a mode ends (a limit position, where it meets another mode and both cease to exist) the
   end is located by :data:`LIMIT_BISECTIONS` bisections, so the trace holds the mode up to within
-  about 1e-11 rad of its limit;
+  about 1e-7 rad of its limit;
 - traces of one mode found from different angles are stitched into one (:func:`_stitched`).
 
 The assembly plan (:mod:`linkage.kinematics.assembly`) then chooses the declared mode among the
@@ -41,8 +41,10 @@ SEEDS = 8
 #: sweep angles (the step shrinks to 1/16 of the sweep's) before the mode is declared ended there
 REFINEMENTS = 4
 #: bisections that locate where a mode ends, between the last sub-step it was followed to and the
-#: next (1/16 of a sweep step, divided by 2**24: about 4e-12 rad for a sweep of 360 angles)
-LIMIT_BISECTIONS = 24
+#: next (1/16 of a sweep step, divided by 2**10: about 1e-7 rad for a sweep of 360 angles), each
+#: with at most LIMIT_STEPS Newton steps (next to the end the mode is singular and flagged anyway)
+LIMIT_BISECTIONS = 10
+LIMIT_STEPS = 12
 #: two poses of a group closer than this fraction of its size are the same assembly mode
 SAME_MODE = 1e-6
 #: new traces started at most (each from a mode no earlier trace holds)
@@ -262,7 +264,8 @@ class _Walk:
         return rows, at, owner, extra
 
 
-def _advance(group, current: Poses, known: Poses, options, size: float, previous: Poses | None = None):
+def _advance(group, current: Poses, known: Poses, options, size: float, previous: Poses | None = None,
+             steps: int | None = None):
     """One step of every trace: from its poses ``current`` ``{link: (C, 3)}`` to the next angle,
     where the known links have the poses ``known`` ``{link: (1, 3)}`` and the listed modes are
     ``options`` (``({link: (1, K, 3)}, valid (1, K))``, or None). Each trace takes the listed
@@ -271,7 +274,8 @@ def _advance(group, current: Poses, known: Poses, options, size: float, previous
     reached and where the step is good: a position that closes to 1e-9 of the size, within
     :data:`TRACE_JUMP` of the size of the current one. ``previous``: the poses one equal step
     before ``current``, when there are: Newton's method then starts from their linear
-    extrapolation (one iteration fewer on a smooth trace)."""
+    extrapolation (one iteration fewer on a smooth trace). ``steps``: Newton steps at most
+    (default :data:`assur.generic.NEWTON_STEPS`)."""
     C = len(next(iter(current.values())))
     reached = {k: np.full((C, 3), np.nan) for k in group.links}
     if options is not None:
@@ -289,7 +293,7 @@ def _advance(group, current: Poses, known: Poses, options, size: float, previous
             ahead = {k: 2 * v[rows] - previous[k][rows] for k, v in current.items()}
             usable = finite_poses(ahead)
             start = {k: np.where(usable[:, None], ahead[k], v) for k, v in start.items()}
-        solved, _ = newton(group, here, start)
+        solved, _ = newton(group, here, start, steps)
         closure = np.max(np.abs(group.residual({**here, **solved})), axis=1)
         with np.errstate(invalid="ignore"):
             ok[rows] = (closure <= 1e-9 * size) & (_moved(group, solved, {k: v[rows] for k, v in current.items()},
@@ -375,7 +379,7 @@ def _limit(group, last: Poses, angle: float, step: float, known_at, listing: boo
         trial = np.array([low + width])
         known = known_at(trial)
         options = group.modes(known) if listing else None
-        reached, ok = _advance(group, here, known, options, size)
+        reached, ok = _advance(group, here, known, options, size, steps=LIMIT_STEPS)
         if ok[0]:
             low, here = float(trial[0]), reached
             good_at.append(low)
@@ -391,15 +395,19 @@ def _limit(group, last: Poses, angle: float, step: float, known_at, listing: boo
 
 def _stitched(group, traces: list[Trace], size: float) -> list[Trace]:
     """The traces with those of one mode joined: a trace that coincides with an earlier one
-    (within :data:`SAME_MODE` of the size at every sweep angle where both exist, and at one at
-    least) is merged into it (its sweep poses fill the earlier one's gaps, its refined samples
-    are added)."""
+    (within :data:`SAME_MODE` of the size) at every sweep angle where both exist, or at two of
+    them at least, is merged into it (its sweep poses fill the earlier one's gaps, its refined
+    samples are added). Two modes meet at single angles (a change point, hardly ever on the
+    sweep itself); a mode that runs on for more than a turn before it ends at a limit position
+    passes some angles twice: its two traces coincide over the rest of the turn, and the merged
+    trace holds one of its two poses there."""
     kept: list[Trace] = []
     for trace in traces:
         for n, other in enumerate(kept):
             gap = poses_distance(trace.rows, other.rows, group.links, size)
             both = np.isfinite(gap)
-            if both.any() and np.all(gap[both] <= SAME_MODE * size):
+            same = np.sum(gap[both] <= SAME_MODE * size)
+            if both.any() and (same == both.sum() or same >= 2):
                 rows = {k: np.where(np.isfinite(v), v, trace.rows[k]) for k, v in other.rows.items()}
                 kept[n] = Trace(rows, np.concatenate([other.refined_at, trace.refined_at]),
                                 {k: np.concatenate([v, trace.refined[k]]) for k, v in other.refined.items()})
