@@ -9,6 +9,8 @@
                             [--method course|exact|ode] [--transient] [--columns LIST]
                             [--format table|csv|json]
     linkage report SCHEME --out DIR                   tables and pictures in one folder
+    linkage sheets SCHEME --out DIR [--position I] [--format pdf,dxf,svg] [--paper A1|A2|A3]
+                                                      the course project's drawing sheets to scale
     linkage variants TEMPLATE ...                     course assignments from a template
     linkage grade FOLDER ANSWERS [--out DIR]          grade a class's answers against the keys
     linkage enumerate SCHEME [--out DIR]              every R/P assignment of the chain's pairs
@@ -19,7 +21,7 @@ Every scheme argument takes ``--input-law LINK:LAW`` for the further inputs of a
 several (docs/inputs.md).
 
 The package holds one module per command (:mod:`.schemes`, :mod:`.analyze`, :mod:`.forces`,
-:mod:`.dynamics`, :mod:`.report`, :mod:`.variants`, :mod:`.grade`, :mod:`.enumeration`, :mod:`.plans`), each with
+:mod:`.dynamics`, :mod:`.report`, :mod:`.sheets`, :mod:`.variants`, :mod:`.grade`, :mod:`.enumeration`, :mod:`.plans`), each with
 an ``add(subparsers)`` function that registers its parser and sets ``handler`` to its
 ``run(args) -> int``, and :mod:`.options` with what the commands share: the argument types and
 the functions that add the common arguments, the help formatter, the table conventions and the
@@ -49,14 +51,15 @@ from typing import Callable, Sequence
 from ..errors import LinkageError
 from ..report.results import NUMERICAL_WARNING
 from ..version import __version__
-from . import analyze, dynamics, enumeration, forces, grade, plans, report, schemes, variants
+from . import analyze, dynamics, enumeration, forces, grade, plans, report, schemes, sheets, variants
 from .options import CONVENTIONS, EXIT_INPUT, EXIT_INTERNAL, PROG, SAID, HelpFormatter, error_lines, note
 
 __all__ = ["main", "build_parser", "COMMANDS", "EXIT_INPUT", "EXIT_INTERNAL"]
 
 
 #: functions that register one subcommand each, in the order ``--help`` lists them
-COMMANDS: list[Callable] = [schemes.add, analyze.add, forces.add, dynamics.add, report.add, variants.add, grade.add,
+COMMANDS: list[Callable] = [schemes.add, analyze.add, forces.add, dynamics.add, report.add, sheets.add, variants.add,
+                            grade.add,
                             enumeration.add, plans.add]
 
 

@@ -1,0 +1,105 @@
+"""The set of a course project's sheets for one mechanism: which can be drawn, in order, numbered.
+
+:func:`project_sheets` composes the kinematics, kinetostatics and dynamics sheets (each from its
+own module) for the sheets whose data the scheme holds, numbered k of K; a sheet whose data are
+missing is left out with a note naming the key to add. :func:`write_project_sheets` writes them
+(:mod:`~.writers`) as ``DIR/SCHEME_kinematics.pdf`` ... in the formats asked.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from pathlib import Path
+from typing import Sequence
+
+from ...errors import LinkageError
+from ...model.mechanism import Mechanism
+from .dynamics_sheet import dynamics_sheet
+from .frame import TitleInfo, layout_problems
+from .kinematics_sheet import kinematics_sheet
+from .kinetostatics_sheet import kinetostatics_sheet
+from .model import Drawing
+from .writers import write
+
+__all__ = ["SHEETS", "project_sheets", "write_project_sheets"]
+
+#: the sheets of a course project, in order: name and what it shows
+SHEETS = (("kinematics", "Kinematic analysis"), ("kinetostatics", "Kinetostatic analysis"),
+          ("dynamics", "Machine dynamics"))
+
+
+def _missing(mech: Mechanism, name: str) -> str | None:
+    """Why the sheet ``name`` cannot be drawn from the scheme (the key to add), or None."""
+    if name == "kinetostatics" and "loads" not in mech.parts and "dynamics" not in mech.parts:
+        return "the scheme declares no [loads] (masses, forces) and no [dynamics] speed: add them to draw the forces"
+    if name == "dynamics" and "dynamics" not in mech.parts:
+        return "the scheme declares no [dynamics] section (mean speed, delta, the load diagram): add it"
+    return None
+
+
+def project_sheets(mech: Mechanism, position: int = 1, paper: str = "A1", title: TitleInfo | None = None,
+                   omega: float | None = None) -> tuple[list[tuple[str, Drawing]], list[str]]:
+    """The sheets ``[(name, drawing)]`` of ``mech`` whose data it holds, numbered k of K, and a note
+    for each sheet left out.
+
+    Parameters
+    ----------
+    mech : Mechanism
+    position : int
+        The table position (1-based) the plans, polygons and groups apart are drawn at.
+    paper : {"A1", "A2", "A3"}
+    title : TitleInfo, optional
+        The title block's texts (default: the scheme's name).
+    omega : float, optional
+        The input's angular velocity for the kinetostatics, rad/s (default: the scheme's mean
+        speed).
+
+    Raises
+    ------
+    LinkageError
+        When the kinematics sheet itself cannot be drawn (the mechanism does not move, the
+        position does not exist ...).
+    """
+    title = title or TitleInfo(scheme=mech.name)
+    notes = []
+    wanted = []
+    for name, what in SHEETS:
+        reason = _missing(mech, name)
+        if reason is None:
+            wanted.append((name, what))
+        else:
+            notes.append(f"the {name} sheet is left out: {reason}")
+    made: list[tuple[str, Drawing]] = []
+    for k, (name, _) in enumerate(wanted, start=1):
+        numbered = replace(title, number=k, total=len(wanted))
+        try:
+            if name == "kinematics":
+                drawing = kinematics_sheet(mech, position, paper, numbered)
+            elif name == "kinetostatics":
+                drawing = kinetostatics_sheet(mech, position, paper, numbered, omega=omega)
+            else:
+                drawing = dynamics_sheet(mech, paper, numbered)
+        except LinkageError as exc:
+            if name == "kinematics":
+                raise
+            notes.append(f"the {name} sheet is left out: {exc}")
+            continue
+        made.append((name, drawing))
+    return made, notes
+
+
+def write_project_sheets(mech: Mechanism, out: str | Path, position: int = 1, formats: Sequence[str] = ("pdf", "dxf"),
+                         paper: str = "A1", title: TitleInfo | None = None, omega: float | None = None
+                         ) -> tuple[list[Path], list[str]]:
+    """Write the sheets of :func:`project_sheets` into the folder ``out`` as
+    ``SCHEME_<sheet>.<format>``; returns the paths written and the notes."""
+    made, notes = project_sheets(mech, position, paper, title, omega)
+    folder = Path(out)
+    folder.mkdir(parents=True, exist_ok=True)
+    written: list[Path] = []
+    for name, drawing in made:
+        problems = layout_problems(drawing)
+        if problems:
+            notes.append(f"the {name} sheet has layout problems: " + "; ".join(problems[:5]))
+        written += write(drawing, folder / f"{mech.name}_{name}", formats)
+    return written, notes
