@@ -325,7 +325,7 @@ def build_variant(template: Template, variant: Variant) -> dict[str, bytes]:
 
     try:
         text = variant_text(template, variant.label, variant.free)
-        mech = loads(text, source=f"{template.source} (variant {variant.label})")
+        mech = loads(text, source=f"variant {variant.label}")
         dynamics = dynamics_results(mech)
         kinematics = kinematics_results(mech)
         forces = forces_results(mech)
