@@ -373,7 +373,7 @@ def test_position_1_of_the_press_is_the_far_extreme_position_in_closed_form(pres
     a = _pin(ax, "A") - _pin(ax, "O")
     assert math.degrees(math.atan2(a[1], a[0])) == pytest.approx(expected, abs=1e-7)
     caption = " ".join(figure_texts(fig, "caption"))
-    assert f"φ = {expected:.1f}°" in caption and "Position 1 of 13:" in caption
+    assert f"φ = {expected:.1f}°" in caption and "Position 1 of 12:" in caption
     assert "clockwise" in caption and "counter-clockwise" not in caption       # mean_rpm = -rpm
     arrow = next(p for p in ax.patches if p.get_gid() == "rotation-arrow")
     path = _arrow_points(ax, arrow)
@@ -388,7 +388,7 @@ def test_a_tiny_mechanism_without_dynamics_is_drawn_at_the_table_position_asked(
     a = _pin(ax, "A") - _pin(ax, "O")
     assert math.degrees(math.atan2(a[1], a[0])) == pytest.approx(90.0, abs=1e-9)
     caption = " ".join(figure_texts(fig, "caption"))
-    assert "Position 4 of 13:" in caption and "φ = 90.0°" in caption
+    assert "Position 4 of 12:" in caption and "φ = 90.0°" in caption
     assert _stated_scale(fig) > 1                                               # an enlargement
 
 

@@ -57,7 +57,9 @@ def add(sub) -> None:
     for option, what in (("--mu-v", "velocity plan, (m/s)/mm"), ("--mu-a", "acceleration plan, (m/s^2)/mm"),
                          ("--mu-f", "force polygons, N/mm")):
         p.add_argument(option, metavar="MU", type=real, default=None,
-                       help=f"scale of the {what} (default: chosen so that the largest vector is about 80 mm)")
+                       help=f"scale of the {what}, in every drawing of the position, the sheet's too (default: "
+                            "the students' scale, 1, 2, 2.5, 4 or 5 x 10^n, that draws the longest vector 60-120 mm "
+                            "long, larger where the drawing would not fit its cell of the sheet)")
     p.set_defaults(handler=run)
 
 

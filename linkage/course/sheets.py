@@ -50,6 +50,7 @@ from ..model.mechanism import Mechanism, Prismatic
 from ..model.scheme import section_of
 from ..report.drawing import Geometry, draw_mechanism, rail_hatch, support
 from ..report.results import declared_rotation, table_defaults, table_positions
+from ..report.words import position_head
 from .diagram_blocks import diagram_block
 from .given import scheme_from_given, sheet_rows
 from .typesetting import (
@@ -313,7 +314,7 @@ def _drawing_caption(drawing: _Drawing) -> str:
     angle = 0.0 if angle >= 359.95 else angle
     sense = "counter-clockwise" if motion.direction > 0 else "clockwise"
     who = _input_word(mech)
-    text = f"Position {i + 1} of {len(motion.phi)}: the {who} at φ = {angle:.1f}° from the x axis"
+    text = f"{position_head(motion, i)}: the {who} at φ = {angle:.1f}° from the x axis"
     if mech.input_range is not None:
         a, b = (float(np.degrees(v)) for v in mech.input_range)
         text += f"; it swings between {a:.4g}° and {b:.4g}°, the table runs {sense} from {a:.4g}° (the arrow)"

@@ -59,7 +59,7 @@ from .drawing import (
 )
 from .labels import points_inside
 from .style import FONT, pyplot
-from .words import CAPTION_CHARS, trajectory_note
+from .words import CAPTION_CHARS, plain, trajectory_note
 
 __all__ = ["Film", "default_trajectories", "film_angles", "write_animation"]
 
@@ -299,12 +299,12 @@ class Film:
         if absolute >= 359.95:
             absolute = 0.0
         who = "input link" if mech.input_range is not None else "crank"
-        where = f"the {who} at φ = {absolute:.1f}° from the x axis"
+        where = f"the {who} at φ = {plain(absolute, '.1f')}° from the x axis"
         head = [f"{mech.name}: {where}"] if len(mech.name) + len(where) + 2 <= CAPTION_CHARS else [mech.name, where]
         if mech.input_range is None:
             turned = float(np.degrees(self.direction * (phi - self.angles[0])))
             sense = "counter-clockwise" if self.direction > 0 else "clockwise"
-            moved = f"turned {turned:.1f}° {sense} from position 1"
+            moved = f"turned {plain(turned, '.1f')}° {sense} from position 1"
         else:
             a, b = np.degrees(mech.input_range)
             moved = f"on its way back from {b:.4g}° to {a:.4g}°" if 2 * k > len(self) else \

@@ -1,8 +1,9 @@
 """The mechanism drawn to scale (equal aspect, axes in m), fully inside the frame.
 
 - :func:`draw_mechanism` -- one position: links as lines and polygons, revolute pairs as circles,
-  sliders as blocks along their guides, guides and slots, frame pivots and guides hatched, point
-  labels placed where they collide with nothing, trajectories of named points;
+  sliders as blocks along their guides, guides and slots, a driven pair between moving links as a
+  cylinder (barrel and rod), frame pivots and guides hatched, point labels placed where they
+  collide with nothing, trajectories of named points;
 - :func:`draw_positions` -- several positions side by side at one common scale.
 
 The pieces the film (:mod:`linkage.report.animation`), the hodographs and the course sheets share:
@@ -61,6 +62,9 @@ class Scene:
     pivots: list[tuple[np.ndarray, float]] = field(default_factory=list)  # frame pivots: point, support direction
     dots: list[str] = field(default_factory=list)                       # named points that are no pair's
     trajectories: list[tuple[str, str, np.ndarray]] = field(default_factory=list)  # (point, link, (M, 2))
+    #: driven prismatic pairs between moving links (cylinders): (barrel link, rod link, barrel
+    #: rectangle (4, 2), rod from its piston to its end (2, 2), piston across the barrel (2, 2))
+    cylinders: list[tuple[str, str, np.ndarray, np.ndarray, np.ndarray]] = field(default_factory=list)
 
 
 def _global(motion, link: str, local, rows) -> np.ndarray:
@@ -173,7 +177,7 @@ class Geometry:
                 continue
             for name, local in mech.links[link].points.items():
                 sc.points.setdefault(name, _global(m, link, local, rows)[0])
-        pair_points, pivots = set(), []
+        pair_points, pivots, barrels = set(), [], set()
         for pair in mech.pairs.values():
             if isinstance(pair, Prismatic):
                 glink, slider = pair.links
@@ -183,7 +187,11 @@ class Geometry:
                 pose = np.zeros((1, 3)) if glink == mech.frame else m.poses[glink][rows]
                 angle = float(pose[0, 2] + guide.angle)
                 centre = _global(m, slider, mech.links[slider].points[pair.point], rows)[0]
-                sc.blocks.append((slider, centre, angle, glink == mech.frame))
+                if pair.name in mech.inputs and glink != mech.frame:
+                    sc.cylinders.append(self._cylinder(pair, pose, centre))
+                    barrels.add((glink, pair.guide))
+                else:
+                    sc.blocks.append((slider, centre, angle, glink == mech.frame))
                 pair_points.add(pair.point)
             else:
                 p = sc.points.get(pair.point)
@@ -195,6 +203,8 @@ class Geometry:
                     pivots.append(p)
         # guides: the sliders' travel plus a block's length at each end
         for (glink, gname), (lo, hi) in self.travel.items():
+            if (glink, gname) in barrels:
+                continue
             guide = mech.links[glink].guides[gname]
             pose = np.zeros((1, 3)) if glink == mech.frame else m.poses[glink][rows]
             c, s = math.cos(pose[0, 2]), math.sin(pose[0, 2])
@@ -219,6 +229,28 @@ class Geometry:
         samples = scene_samples(sc, u)
         sc.pivots = [(p, _pivot_direction(p, sc, u, samples)) for p in pivots]
         return sc
+
+    def _cylinder(self, pair, pose: np.ndarray, end: np.ndarray):
+        """A cylinder drawn as a barrel and a rod that stay joined over the stroke: the barrel
+        from its pivot end (or behind it, for a stroke longer than the shortest extension) to a
+        gland 1.2 unit short of the rod end's nearest place; the rod, one length, from its end
+        into the barrel, its piston 1.2 unit inside the gland at the longest extension."""
+        barrel, rod = pair.links
+        guide = self.mech.links[barrel].guides[pair.guide]
+        lo, hi = self.travel[(barrel, pair.guide)]
+        c, s = math.cos(pose[0, 2]), math.sin(pose[0, 2])
+        rot = np.array([[c, -s], [s, c]])
+        start = pose[0, :2] + rot @ np.asarray(guide.point, dtype=float)
+        direction = rot @ np.array(guide.direction)
+        u = self.unit
+        front = max(lo - 1.2 * u, 0.5 * lo)
+        rod_length = hi - front + 1.2 * u
+        back = min(0.0, lo - rod_length - 1.2 * u)
+        piston = end - rod_length * direction
+        across = 0.55 * u * np.array([-direction[1], direction[0]])
+        tube = _rect(start + (back + front) / 2 * direction, math.atan2(direction[1], direction[0]),
+                     front - back, 1.4 * u)
+        return barrel, rod, tube, np.array([piston, end]), np.array([piston - across, piston + across])
 
     def _hatch_side(self, line: np.ndarray, direction: np.ndarray) -> np.ndarray:
         """The side of a frame guide with fewer of the mechanism's points over a turn."""
@@ -273,6 +305,7 @@ def scene_samples(sc: Scene, u: float) -> np.ndarray:
         lines += [line, rail_hatch(line, side, u)[0]]
     lines += [np.vstack([r := _rect(c, a, *_block_size(u, f)), r[:1]]) for _, c, a, f in sc.blocks]
     lines += [curve for _, _, curve in sc.trajectories]
+    lines += [item for _, _, tube, rod, _ in sc.cylinders for item in (np.vstack([tube, tube[:1]]), rod)]
     out = []
     for pts in lines:
         for a, b in zip(pts[:-1], pts[1:]):
@@ -326,6 +359,8 @@ def drawing_limits(sc_list: Sequence[Scene], geometry: Geometry) -> tuple[float,
             pts += list(tri) + list(ground) + list(strokes.reshape(-1, 2))
         for _, _, curve in sc.trajectories:
             pts += list(curve)
+        for _, _, tube, rod, _ in sc.cylinders:
+            pts += list(tube) + list(rod)
     pts = np.array(pts, dtype=float).reshape(-1, 2)
     pts = pts[np.all(np.isfinite(pts), axis=1)]
     lo, hi = pts.min(axis=0), pts.max(axis=0)
@@ -422,7 +457,7 @@ def draw_mechanism(motion, position: int = 0, ax=None, *, labels: bool | Iterabl
     >>> motion = linkage.analyze(mech, linkage.table_angles(mech, 12))
     >>> ax = draw_mechanism(motion, 3, trajectories=["E"])
     >>> print(ax.get_title("left"))
-    Position 4 of 13: the crank turned 90° counter-clockwise
+    Position 4 of 12: the crank turned 90° counter-clockwise
     from position 1 (φ = 325.8° from the x axis)
     dashed: trajectory of E over a turn
     >>> ax.figure.savefig(io.BytesIO(), format="png")
@@ -595,6 +630,10 @@ def scene_obstacles(sc: Scene, u: float, base: Drawn | None = None, trajectory_s
         rect = _rect(centre, angle, *_block_size(u, on_frame))
         drawn.polyline(rect, closed=True)
         drawn.areas.append(rect)
+    for _, _, tube, rod, _ in sc.cylinders:
+        drawn.polyline(tube, closed=True)
+        drawn.areas.append(tube)
+        drawn.polyline(rod)
     drawn.discs += [(p, PIN * u) for _, p in sc.pins] + [(sc.points[n], DOT * u) for n in sc.dots]
     return drawn
 
@@ -629,6 +668,14 @@ def moving_artists(sc: Scene, geometry: Geometry) -> list:
                            gid=f"block:{link}"))
         out.append(Polygon(rect, closed=True, fc=colour[link], alpha=0.25, ec="none",
                            zorder=6.6 if on_frame else 7.1))
+    for barrel, rod, tube, line, piston in sc.cylinders:
+        out.append(Polygon(tube, closed=True, fc=colour[barrel], alpha=0.18, ec="none", zorder=6))
+        out.append(Polygon(tube, closed=True, fill=False, ec=colour[barrel], lw=2.2, zorder=6.1,
+                           gid=f"barrel:{barrel}"))
+        out.append(Line2D(line[:, 0], line[:, 1], color=colour[rod], lw=3.0, solid_capstyle="butt", zorder=6.3,
+                          gid=f"rod:{rod}"))
+        out.append(Line2D(piston[:, 0], piston[:, 1], color=colour[rod], lw=3.0, solid_capstyle="butt", zorder=6.3,
+                          gid=f"piston:{rod}"))
     for name, p in sc.pins:
         out.append(Circle(p, PIN * u, fc="white", ec="black", lw=1.4, zorder=8, gid=f"pair:{name}"))
     for name in sc.dots:
@@ -672,14 +719,17 @@ def _metre_ticks(ax) -> None:
 # ----------------------------------------------------------------------------------------------
 
 
-def place_point_labels(ax, sc: Scene, names: Sequence[str], drawn: Drawn, font: int, pin_radius: float) -> None:
+def place_point_labels(ax, sc: Scene, names: Sequence[str], drawn: Drawn, font: int, pin_radius: float, *,
+                       ranked: bool = False, drop: float = math.inf) -> list[str]:
     """Write the point names where they cover no line, symbol or other label, inside the axes.
 
     Works in display coordinates: each label tries 24 directions at three distances from its
     point and takes the candidate of least penalty (:func:`~linkage.report.labels.place_labels`):
     outside the axes, on another label, on a pair's circle, on a line (by the length covered),
     inside a link or block, far from its point or from the direction away from its links.
-    Deterministic.
+    Deterministic. Pairs' points are placed first (the most crowded), or with ``ranked`` the
+    names in the order given; a label whose best place costs ``drop`` or more (1e4: it would
+    overlap a label placed before) is left out. Returns the names written.
     """
     fig = ax.figure
     ax.apply_aspect()
@@ -704,7 +754,7 @@ def place_point_labels(ax, sc: Scene, names: Sequence[str], drawn: Drawn, font: 
     r_pin = pin_radius * px_per_m
     centre_all = np.mean(np.array(list(sc.points.values())), axis=0)
     pin_points = _pin_points(sc)
-    order = sorted(names, key=lambda n: (n not in pin_points, n))   # pairs first: the most crowded
+    order = list(names) if ranked else sorted(names, key=lambda n: (n not in pin_points, n))  # pairs first
     steps = 2 * np.pi * np.arange(24) / 24
     ring = np.repeat(np.arange(3), len(steps))
     labels = []
@@ -717,10 +767,14 @@ def place_point_labels(ax, sc: Scene, names: Sequence[str], drawn: Drawn, font: 
         angle = away + np.tile(steps, 3)
         deviation = np.abs((angle - away + np.pi) % (2 * np.pi) - np.pi)
         labels.append(Label(text, to_px(p[None])[0], np.stack([np.cos(angle), np.sin(angle)], axis=1),
-                            r_pin + 3 + 5 * scale * ring, 40.0 * ring + 15.0 * deviation))
-    for label, place in zip(labels, place_labels(labels, on_screen, inner, renderer)):
-        offset = place.centre - label.anchor
-        label.text.set_position((offset[0] / scale, offset[1] / scale))
+                            r_pin + 3 + 5 * scale * ring, 40.0 * ring + 15.0 * deviation, drop))
+    written = []
+    for name, label, place in zip(order, labels, place_labels(labels, on_screen, inner, renderer)):
+        if place is not None:
+            offset = place.centre - label.anchor
+            label.text.set_position((offset[0] / scale, offset[1] / scale))
+            written.append(name)
+    return written
 
 
 def _pin_points(sc: Scene) -> set[str]:

@@ -34,9 +34,10 @@ from .animation import write_animation
 from .diagrams import plot_columns, plot_dynamics, plot_motion
 from .drawing import draw_mechanism, draw_positions
 from .hodographs import plot_hodographs
+from .resistance import plot_resistance, resistance_curves
 from .results import dynamics_results, forces_results, kinematics_results
 from .tables import format_columns, units_of
-from .words import link_role
+from .words import link_role, speed_words
 
 __all__ = ["ReportExtraMissing", "Report", "write_report", "REPORT_EXTRA"]
 
@@ -222,10 +223,16 @@ class _Work:
 
         who = "input link" if load == "moment" else "input slide"
         self._picture(f"balancing_{load}", f"Balancing {load} on the {who}"
-                      + ("s" if len(self.mech.inputs) > 1 else "") + " (kinetostatics at the scheme's speed)",
+                      + ("s" if len(self.mech.inputs) > 1 else "")
+                      + f" ({self._speed_note()})",
                       balancing)
         self._picture("hodographs", "Hodographs of the reactions in the main pairs",
                       lambda: plot_hodographs(self.forces.reactions))
+
+    def _speed_note(self) -> str:
+        """At what speed the forces were found: a static case says so."""
+        words = speed_words(self.forces.reactions.motion)
+        return "static: no speed given, no inertia forces" if words.startswith("no speed") else f"kinetostatics {words}"
 
     def dynamics_tables(self) -> None:
         try:
@@ -252,6 +259,29 @@ class _Work:
                       lambda: machine.plot_speed_two_ways(report))
         self._picture("law_of_motion", "Law of motion and balancing moment under the real motion",
                       lambda: plot_dynamics(report, ["omega", "eps", "balancing_moment"]))
+        self._picture("reduced_inertia", "Reduced moment of inertia I_red(φ)",
+                      lambda: plot_dynamics(report, ["reduced_inertia"]))
+        if resistance_curves(self.kinematics.motion):
+            self._picture("resistance", "Useful resistance over the stroke, P(s)",
+                          lambda: plot_resistance(self.kinematics.motion))
+        self._course_delta(report)
+
+    def _course_delta(self, report) -> None:
+        """Say plainly when the course method's flywheel misses δ under the exact solution."""
+        law = report.law
+        if law.method == "exact" or law.required_constant_inertia is None:
+            return
+        try:
+            omega_m, delta = machine._mean_speed_and_delta(law)
+            ode, _ = machine._steady_with_constant_moment(self.mech, law, omega_m, delta)
+        except (LinkageError, ValueError, ZeroDivisionError):
+            return
+        if ode.delta_actual > delta * (1 + 1e-3):
+            self.report.notes.append(
+                f"the course method's flywheel misses δ: under the exact solution (the equation of motion, "
+                f"periodic steady state) it gives δ = {ode.delta_actual:.4g}, not the target {delta:.4g} "
+                f"({100 * (ode.delta_actual / delta - 1):.3g} % more); 'linkage dynamics --method ode' sizes "
+                "the flywheel for δ exactly")
 
     def startup(self) -> None:
 

@@ -27,12 +27,11 @@ from itertools import pairwise
 import numpy as np
 
 from ..errors import InputError
-from ..kinematics.motion import table_positions_deg
 from ..model.mechanism import Mechanism
 from .drawing import Scene, place_point_labels
 from .labels import Drawn
-from .style import CURVE_COLOURS, FONT, PAGE_WIDTH, SMALL, new_figure, pyplot
-from .words import link_role
+from .style import CURVE_COLOURS, FONT, PAGE_WIDTH, SMALL, fit_width, new_figure, pyplot
+from .words import link_role, speed_words, table_span
 
 __all__ = ["main_pairs", "pair_words", "plot_hodographs"]
 
@@ -104,34 +103,29 @@ def _chosen_pairs(reactions, pairs: Sequence[str] | None) -> list[str]:
     return list(dict.fromkeys(names))
 
 
-def _speed_words(reactions) -> str:
-    omega = reactions.motion.omega
-    if omega is None or not np.any(np.isfinite(omega) & (omega != 0)):
-        return "no speed given: static reactions, without inertia forces"
-    finite = omega[np.isfinite(omega)]
-    if np.ptp(finite) <= 1e-12 * np.max(np.abs(finite)):
-        return f"at ω = {float(finite[0]):.5g} rad/s".replace("-", "−")
-    return f"at ω from {float(finite.min()):.4g} to {float(finite.max()):.4g} rad/s".replace("-", "−")
-
-
-def _numbers(points: np.ndarray, numbers: np.ndarray, span: float) -> dict[str, np.ndarray]:
-    """Label text -> point: table positions whose vectors coincide (to 1e-9 of the drawing's
-    span, e.g. positions 1 and n+1 of a turn) share one label, ``"1, 13"``. Of more than
-    :data:`NUMBERED` positions, every k-th and the last are numbered."""
+def _numbers(points: np.ndarray, numbers: np.ndarray, span: float, closed: bool) -> dict[str, np.ndarray]:
+    """Label text -> point, in the order the labels are placed (a label with no room is left
+    out): position 1, then every :data:`COARSE`-th, then the others. Table positions whose
+    vectors coincide (to 1e-9 of the drawing's span) share one label, ``"3, 9"``; over a turn
+    (``closed``) the last row is position 1 again and carries no number of its own."""
     labels: dict[str, np.ndarray] = {}
-    taken = np.zeros(len(points), bool)
+    count = len(points) - 1 if closed else len(points)
     ok = np.all(np.isfinite(points), axis=1)
-    step = math.ceil(len(points) / NUMBERED)
-    if step > 1:
-        ok[np.arange(len(points)) % step != 0] = False
-        ok[-1] = bool(np.all(np.isfinite(points[-1])))
-    for k in np.flatnonzero(ok):
+    ok[count:] = False
+    taken = ~ok
+    rank = np.arange(count)
+    order = sorted(rank, key=lambda k: (k != 0, k % COARSE != 0, k))
+    for k in order:
         if taken[k]:
             continue
-        same = ok & ~taken & (np.hypot(*(points - points[k]).T) <= 1e-9 * span)
+        same = ~taken & (np.hypot(*(points - points[k]).T) <= 1e-9 * span)
         taken |= same
         labels[", ".join(str(int(n)) for n in numbers[same])] = points[k]
     return labels
+
+
+#: every COARSE-th table position is numbered before the others
+COARSE = 6
 
 
 def plot_hodographs(reactions, pairs: Sequence[str] | None = None, *, fine=None):
@@ -140,8 +134,9 @@ def plot_hodographs(reactions, pairs: Sequence[str] | None = None, *, fine=None)
 
     Each panel shows, for a pair K declared with ``links = [a, b]``, the force ``R[a, b]`` that
     link b exerts on link a (the forces table's ``K.Rx``, ``K.Ry``), N, with equal scales on both
-    axes: the table positions as circles numbered along the curve (positions that coincide, like
-    1 and n+1 of a turn, share a label), thin lines from the origin to them (the vectors), and
+    axes: the table positions as circles numbered along the curve where a number has room (1,
+    then every 6th, then the others; positions that coincide share a label, and over a turn row
+    n+1, position 1 again, has none), thin lines from the origin to them (the vectors), and
     the axes through the origin. A pair whose reaction is zero at every position (no masses,
     loads or inertia forces reach it) gets a note instead of an empty panel.
 
@@ -193,9 +188,10 @@ def plot_hodographs(reactions, pairs: Sequence[str] | None = None, *, fine=None)
     fig = new_figure(PAGE_WIDTH, min(9.5, 0.75 + PANEL_HEIGHT * nrows))
     grid = fig.subplots(nrows, ncols, squeeze=False).ravel()
     numbers = np.arange(1, len(reactions.motion.phi) + 1)
-    fig.suptitle(_header(reactions), fontsize=FONT)
+    fit_width(fig.suptitle(_header(reactions), fontsize=FONT))
+    distinct = numbers[:-1] if table_span(reactions.motion).endswith(" = 1)") else numbers
     for ax in grid[len(names):]:              # an empty cell: how to read the panels
-        _key(ax, numbers, fine is not None)
+        _key(ax, distinct, fine is not None)
     placed = []
     for k, (ax, name) in enumerate(zip(grid, names)):
         force = reactions.force(name)
@@ -209,19 +205,18 @@ def plot_hodographs(reactions, pairs: Sequence[str] | None = None, *, fine=None)
         placed.append(_panel(ax, name, force, curve, CURVE_COLOURS[k % len(CURVE_COLOURS)]))
     fig.canvas.draw()                      # constrained layout places the panels once ...
     fig.set_layout_engine("none")          # ... and keeps them, so that the numbers stay where placed
+    closed = table_span(reactions.motion).endswith(" = 1)")
     for ax, name, force in placed:
         _equal_scales(ax)
         _thin_ticks(ax)
-        _number(ax, force, numbers)
+        _number(ax, force, numbers, closed)
     return fig
 
 
 def _header(reactions) -> str:
     mech = reactions.motion.mechanism
-    span = table_positions_deg(reactions.motion.phi, reactions.motion.direction)
-    over = f" ({float(span[-1]):.4g}° of the input)" if len(span) > 1 else ""
-    return (f"Hodographs of the pair reactions of {mech.name}, {_speed_words(reactions)}\n"
-            f"vectors R from the origin (+) at the {len(span)} table positions{over}, numbered")
+    return (f"Hodographs of the pair reactions of {mech.name},\n{speed_words(reactions.motion)};\n"
+            f"vectors R from the origin (+) at the {table_span(reactions.motion)}, numbered where there is room")
 
 
 def _key(ax, numbers: np.ndarray, fine: bool) -> None:
@@ -233,6 +228,7 @@ def _key(ax, numbers: np.ndarray, fine: bool) -> None:
              "grey lines: R at the table",
              f"     positions {last}",
              "circles: their tips, numbered",
+             "     where there is room",
              "curve: the tip of R over the cycle",
              f"     ({curve})",
              "R in a pair [a, b]: the force of",
@@ -281,7 +277,7 @@ def _panel(ax, name: str, force: np.ndarray, curve: np.ndarray, colour: str):
 
 #: size of the table positions' circles, points (smaller for more than :data:`NUMBERED`)
 MARKER = 5.0
-#: most positions numbered on a hodograph
+#: of more positions than this, the circles are drawn smaller
 NUMBERED = 40
 
 
@@ -326,14 +322,15 @@ def _thin_ticks(ax) -> None:
                 break
 
 
-def _number(ax, force: np.ndarray, numbers: np.ndarray) -> None:
+def _number(ax, force: np.ndarray, numbers: np.ndarray, closed: bool) -> list[str]:
     """Number the table positions along the hodograph, where the numbers cover no line, circle
-    or other number (:func:`~linkage.report.drawing.place_point_labels`, outward from the curve)."""
+    or other number (:func:`~linkage.report.drawing.place_point_labels`, outward from the curve);
+    a number with no room left is left out. Returns the labels written."""
     ax.apply_aspect()
     x0, x1 = ax.get_xlim()
     y0, y1 = ax.get_ylim()
     span = max(x1 - x0, y1 - y0)
-    sc = Scene(points=_numbers(force, numbers, span))
+    sc = Scene(points=_numbers(force, numbers, span, closed))
     px_per_unit = abs(ax.transData.transform([[1.0, 0.0]])[0, 0] - ax.transData.transform([[0.0, 0.0]])[0, 0])
     radius = (_marker(len(force)) / 2 + 0.7) * ax.figure.dpi / 72.0 / px_per_unit
     drawn = Drawn()
@@ -348,4 +345,4 @@ def _number(ax, force: np.ndarray, numbers: np.ndarray) -> None:
             drawn.polyline(seg, light=True)
     drawn.polyline(np.array([[x0, 0.0], [x1, 0.0]]), light=True)
     drawn.polyline(np.array([[0.0, y0], [0.0, y1]]), light=True)
-    place_point_labels(ax, sc, list(sc.points), drawn, SMALL, radius)
+    return place_point_labels(ax, sc, list(sc.points), drawn, SMALL, radius, ranked=True, drop=1e4)

@@ -48,8 +48,9 @@ from .words import position_caption, subscript
 __all__ = ["TARGET_MM", "nice_scale", "drawing_scales", "draw_plan", "draw_force_polygons", "draw_lever", "draw_sheet",
            "write_plan_drawings"]
 
-#: length of the largest vector of a drawing at an automatic scale, mm
-TARGET_MM = 80.0
+#: the longest vector of a plan (the span of a force polygon) at an automatic scale is at most this
+#: long, and over half as long (the students' scales step by at most 2): 60-120 mm, mm
+TARGET_MM = 120.0
 #: millimetres per inch
 INCH = 25.4
 #: the mantissas of a scale (students' scales: 1, 2, 2.5, 4, 5 times a power of ten)
@@ -478,11 +479,12 @@ def _lever_sketch(plans: Plans, i: int, scale: float, force_scale: float) -> _Sk
     return sk
 
 
-def _lever_fit(plans: Plans, i: int, room_w: float, room_h: float) -> tuple[float, float]:
-    """The scales of the plan and of the forces of a lever that fits ``room_w`` by ``room_h`` mm."""
+def _lever_fit(plans: Plans, i: int, room_w: float, room_h: float, smallest: float = 0.0) -> tuple[float, float]:
+    """The scales of the plan (``smallest`` or larger) and of the forces of a lever that fits
+    ``room_w`` by ``room_h`` mm."""
     turned = np.array([img[i] for img in plans.velocity.images.values()] + [np.zeros(2)])
     span = np.ptp(turned, axis=0)[::-1]
-    scale = nice_scale(max(span[0] / room_w, span[1] / room_h, 1e-300))
+    scale = max(smallest, nice_scale(max(span[0] / room_w, span[1] / room_h, 1e-300)))
     force_scale = _lever_force_scale(plans, i, target=max(0.25 * float(min(span.max() / scale, room_h)), 8.0))
     for _ in range(20):
         x0, x1, y0, y1 = _lever_sketch(plans, i, scale, force_scale).extent()
@@ -498,16 +500,26 @@ def _lever_force_scale(plans: Plans, i: int, target: float = 25.0) -> float:
 
 
 def drawing_scales(plans: Plans, position: int, given: Mapping[str, object] | None = None) -> dict[str, object]:
-    """The scales of the standalone drawings of one position: ``velocity`` ((m/s)/mm),
-    ``acceleration`` ((m/s²)/mm) and ``force`` (step -> N/mm), the ``given`` ones (``force``: one
-    number for every polygon, or step -> number) else those chosen automatically."""
+    """The scales of every drawing of one position, the standalone ones and the sheet's alike:
+    ``velocity`` ((m/s)/mm), ``acceleration`` ((m/s²)/mm) and ``force`` (step -> N/mm), the
+    ``given`` ones (``force``: one number for every polygon, or step -> number) else those chosen
+    automatically: the students' scale that draws the longest vector 60-120 mm long
+    (:data:`TARGET_MM`), or a larger one where the drawing would not fit its cell of the sheet."""
     i = _check(plans, position)
     given = dict(given or {})
     forces = given.get("force")
-    return {"velocity": given.get("velocity") or _plan_scale(plans, i, "velocity"),
-            "acceleration": given.get("acceleration") or _plan_scale(plans, i, "acceleration"),
-            "force": {p.step: (forces.get(p.step) if isinstance(forces, Mapping) else forces)
-                      or _polygon_scale(p, i) for p in plans.polygons}}
+    room = _sheet_room(plans)
+
+    def fitted(chosen: float, unit_sketch: _Sketch) -> float:
+        x0, x1, y0, y1 = unit_sketch.extent()
+        return max(chosen, nice_scale(max((x1 - x0) / room[0], (y1 - y0) / room[1], 1e-300)))
+
+    colour = _colours(plans.motion.mechanism)
+    plan = {q: given.get(q) or fitted(_plan_scale(plans, i, q), _plan_sketch(plans, i, q, 1.0, table=False))
+            for q in ("velocity", "acceleration")}
+    return {**plan, "force": {p.step: (forces.get(p.step) if isinstance(forces, Mapping) else forces)
+                              or fitted(_polygon_scale(p, i), _polygon_sketch(p, i, 1.0, colour))
+                              for p in plans.polygons}}
 
 
 # ----------------------------------------------------------------------------------------------
@@ -536,7 +548,7 @@ def _true_scale_figure(sketches: Sequence[_Sketch], header: Sequence[str]):
     plt = pyplot()
     pad = 8.0
     sizes = [_sketch_size(sk) for sk in sketches]
-    columns = [math.ceil(len(sk.table) / COLUMN_LINES) for sk in sketches]
+    columns = [len(_table_columns(sk.table)) for sk in sketches]
     cells = [max(w, 45.0, c * COLUMN_MM) for (w, _), c in zip(sizes, columns)]
     width = sum(cells) + pad * (len(sketches) + 1)
     if width < MIN_WIDTH_MM:
@@ -568,16 +580,22 @@ def _true_scale_figure(sketches: Sequence[_Sketch], header: Sequence[str]):
         ax = fig.add_axes(((left + (cell - w) / 2) / width, (top - title_h - h) / height, w / width, h / height))
         x0, x1, y0, y1 = sk.extent()
         _draw(ax, sk, (x0 - MARGIN_MM, x1 + MARGIN_MM, y0 - MARGIN_MM, y1 + MARGIN_MM))
-        for k, row_cells in enumerate(sk.table):
-            col, row = divmod(k, COLUMN_LINES)
-            for content, offset in zip(row_cells, CELL_MM):
-                text(left + col * COLUMN_MM + offset, top - title_h - draw_h - 4 - (row + 0.8) * TABLE_LINE_MM,
-                     content, SMALL - 1)
+        for col, rows_of_column in enumerate(_table_columns(sk.table)):
+            for row, row_cells in enumerate(rows_of_column):
+                for content, offset in zip(row_cells, CELL_MM):
+                    text(left + col * COLUMN_MM + offset, top - title_h - draw_h - 4 - (row + 0.8) * TABLE_LINE_MM,
+                         content, SMALL - 1)
         below = top - title_h - draw_h - 4 - min(len(sk.table), COLUMN_LINES) * TABLE_LINE_MM - 2
         for k, line in enumerate(sk.footer):
             text(left, below - (k + 0.8) * LINE_MM, line, SMALL)
         left += cell + pad
     return fig
+
+
+def _table_columns(table: list[tuple[str, ...]]) -> list[list[tuple[str, ...]]]:
+    """A table's rows in columns of at most :data:`COLUMN_LINES` lines, each under the header row."""
+    per = COLUMN_LINES - 1
+    return [[table[0], *table[1 + k:1 + k + per]] for k in range(0, max(len(table) - 1, 1), per)] if table else []
 
 
 def _header(plans: Plans, i: int) -> list[str]:
@@ -621,7 +639,7 @@ def draw_plan(plans: Plans, position: int, quantity: str = "velocity", *, scale:
     if quantity not in _SYMBOLS:
         raise InputError(f"quantity must be 'velocity' or 'acceleration', got {quantity!r}")
     i = _check(plans, position)
-    scale = _plan_scale(plans, i, quantity) if scale is None else _positive(scale, "scale")
+    scale = drawing_scales(plans, i)[quantity] if scale is None else _positive(scale, "scale")
     return _true_scale_figure([_plan_sketch(plans, i, quantity, scale)], _header(plans, i))
 
 
@@ -641,10 +659,10 @@ def draw_force_polygons(plans: Plans, position: int, *, scales: Mapping[str, flo
     """
     i = _check(plans, position)
     colour = _colours(plans.motion.mechanism)
+    chosen = drawing_scales(plans, i, {"force": scales})["force"]
     sketches = []
     for polygon in plans.polygons:
-        given = scales.get(polygon.step) if isinstance(scales, Mapping) else scales
-        scale = _polygon_scale(polygon, i) if given is None else _positive(given, "force scale")
+        scale = _positive(chosen[polygon.step], "force scale")
         sk = _polygon_sketch(polygon, i, scale, colour)
         sk.title = [f"Forces on {polygon.step}:  {MU_F} = {_number(scale)} N/mm"]
         sk.table = _polygon_table(polygon, i, scale)
@@ -661,7 +679,7 @@ def draw_lever(plans: Plans, position: int, *, scale: float | None = None, force
     gives next to the kinetostatic one. ``scale``: μ_v, (m/s)/mm; ``force_scale``: μ_F of the
     arrows, N/mm (defaults: chosen)."""
     i = _check(plans, position)
-    scale = _plan_scale(plans, i, "velocity") if scale is None else _positive(scale, "scale")
+    scale = drawing_scales(plans, i)["velocity"] if scale is None else _positive(scale, "scale")
     force_scale = _lever_force_scale(plans, i) if force_scale is None else _positive(force_scale, "force scale")
     return _true_scale_figure([_lever_sketch(plans, i, scale, force_scale)], _header(plans, i))
 
@@ -670,26 +688,41 @@ def draw_lever(plans: Plans, position: int, *, scale: float | None = None, force
 # the sheet
 # ----------------------------------------------------------------------------------------------
 
-#: the sheet: A3 landscape, mm
+#: the sheet: A3 landscape; its header, the gap between its cells and a cell's title, mm
 SHEET = (420.0, 297.0)
+SHEET_HEAD, SHEET_PAD, SHEET_TITLE = 16.0, 7.0, 9.0
 
 
-def draw_sheet(plans: Plans, position: int):
+def _sheet_cells(plans: Plans) -> tuple[int, int, float, float]:
+    """Columns, rows, width and height (mm) of the cells of :func:`draw_sheet`."""
+    cells = 3 + len(plans.polygons) + 1
+    ncols = max(3, math.ceil(cells / 2))
+    nrows = math.ceil(cells / ncols)
+    width, height = SHEET
+    return (ncols, nrows, (width - SHEET_PAD * (ncols + 1)) / ncols,
+            (height - SHEET_HEAD - SHEET_PAD * nrows) / nrows)
+
+
+def _sheet_room(plans: Plans) -> tuple[float, float]:
+    """The room a drawing has in its cell of the sheet, inside its margins, mm."""
+    _, _, cell_w, cell_h = _sheet_cells(plans)
+    return cell_w - 2 * MARGIN_MM, cell_h - SHEET_TITLE - 2 * MARGIN_MM
+
+
+def draw_sheet(plans: Plans, position: int, *, scales: Mapping[str, object] | None = None):
     """One sheet (A3 landscape, true to size when printed at 100 %) for one position: the
     mechanism to scale, the plans of velocities and accelerations, the force polygons and
-    Zhukovsky's lever, each at a scale chosen to fill its cell and written on it."""
+    Zhukovsky's lever, each at the scale of every drawing of the position
+    (:func:`drawing_scales`, ``scales`` given as there) written on it."""
 
     plt = pyplot()
     i = _check(plans, position)
     motion = plans.motion
     colour = _colours(motion.mechanism)
-    cells = 3 + len(plans.polygons) + 1
-    ncols = max(3, math.ceil(cells / 2))
-    nrows = math.ceil(cells / ncols)
+    shared = drawing_scales(plans, i, scales)
+    ncols, nrows, cell_w, cell_h = _sheet_cells(plans)
     width, height = SHEET
-    head_h, pad, title_h = 16.0, 7.0, 9.0
-    cell_w = (width - pad * (ncols + 1)) / ncols
-    cell_h = (height - head_h - pad * nrows) / nrows
+    head_h, pad, title_h = SHEET_HEAD, SHEET_PAD, SHEET_TITLE
     fig = plt.figure(figsize=(width / INCH, height / INCH), dpi=DPI)
     for k, line in enumerate(_header(plans, i)):
         fig.text(pad / width, 1 - (5 + k * LINE_MM) / height, line, fontsize=FONT, ha="left", va="baseline")
@@ -707,29 +740,22 @@ def draw_sheet(plans: Plans, position: int):
                        (room_h - 12) / height))
     draw_mechanism(motion, i, ax=ax, caption=False)
     fig.text(left / width, (top - 0.8 * LINE_MM) / height, "Mechanism", fontsize=FONT, ha="left", va="baseline")
-    panels: list[tuple[_Sketch, str]] = []
-    for quantity in ("velocity", "acceleration"):
-        sk = _plan_sketch(plans, i, quantity, 1.0, table=False)
-        panels.append((sk, quantity))
-    for polygon in plans.polygons:
-        panels.append((_polygon_sketch(polygon, i, 1.0, colour), polygon.step))
-    panels.append((_lever_sketch(plans, i, 1.0, 1.0), "lever"))
-    for k, (unit_sketch, what) in enumerate(panels, start=1):
-        x0, x1, y0, y1 = unit_sketch.extent()
-        fit = max((x1 - x0) / (room_w - 2 * MARGIN_MM), (y1 - y0) / (room_h - 2 * MARGIN_MM), 1e-300)
+    panels = ["velocity", "acceleration", *(polygon.step for polygon in plans.polygons), "lever"]
+    for k, what in enumerate(panels, start=1):
         if what in ("velocity", "acceleration"):
-            scale = nice_scale(fit)
+            scale = float(shared[what])
             sk = _plan_sketch(plans, i, what, scale, table=False)
             title = sk.title[0]
         elif what == "lever":
-            scale, force_scale = _lever_fit(plans, i, room_w - 2 * MARGIN_MM, room_h - 2 * MARGIN_MM)
+            scale, force_scale = _lever_fit(plans, i, room_w - 2 * MARGIN_MM, room_h - 2 * MARGIN_MM,
+                                            float(shared["velocity"]))
             sk = _lever_sketch(plans, i, scale, force_scale)
             title = (f"Zhukovsky's lever (the plan turned 90° clockwise): $\\mu_v$ = {_number(scale)} (m/s)/mm, "
                      f"{MU_F} = {_number(force_scale)} N/mm; $M_b$ = "
                      f"{_number(float(plans.lever.balancing_moment[i]))} N·m")
         else:
             polygon = next(p for p in plans.polygons if p.step == what)
-            scale = nice_scale(fit)
+            scale = float(shared["force"][what])
             sk = _polygon_sketch(polygon, i, scale, colour)
             title = f"Forces on {what}:  {MU_F} = {_number(scale)} N/mm"
         w, h = _sketch_size(sk)
@@ -777,7 +803,7 @@ def write_plan_drawings(plans: Plans, position: int, folder: str | Path, *, form
                "acceleration": lambda: draw_plan(plans, position, "acceleration", scale=scales.get("acceleration")),
                "forces": lambda: draw_force_polygons(plans, position, scales=scales.get("force")),
                "lever": lambda: draw_lever(plans, position, scale=scales.get("velocity")),
-               "sheet": lambda: draw_sheet(plans, position)}
+               "sheet": lambda: draw_sheet(plans, position, scales=scales)}
     written = []
     for name in drawings:
         fig = figures[name]()

@@ -24,7 +24,7 @@ from __future__ import annotations
 from ..errors import LinkageError
 
 __all__ = ["INSTALL_HINT", "PAGE_WIDTH", "FONT", "SMALL", "LINK_COLOURS", "CURVE_COLOURS", "MARKERS",
-           "PlotExtraMissing", "pyplot", "new_figure"]
+           "PlotExtraMissing", "pyplot", "new_figure", "fit_width"]
 
 
 #: what to install for pictures
@@ -61,3 +61,19 @@ def new_figure(width: float, height: float, layout: str | None = "constrained"):
     """A new figure ``width`` by ``height`` inches, laid out by ``layout`` (constrained by default)."""
     plt = pyplot()
     return plt.figure(figsize=(width, height), layout=layout)
+
+
+def fit_width(text, margin: float = 0.02) -> None:
+    """Re-wrap a matplotlib Text (a title, a caption) at fewer characters a line until it is no
+    wider than its figure less ``margin`` (a fraction of the width) on each side: no title runs
+    off the picture. Lines already short enough are kept as they are."""
+    import textwrap
+
+    fig = text.get_figure()
+    renderer = fig.canvas.get_renderer()
+    room = fig.bbox.width * (1 - 2 * margin)
+    original = text.get_text().split("\n")
+    chars = max((len(line) for line in original), default=0)
+    while chars > 20 and text.get_window_extent(renderer).width > room:
+        chars = int(chars * 0.92)
+        text.set_text("\n".join(part for line in original for part in (textwrap.wrap(line, chars) or [""])))

@@ -33,7 +33,8 @@ from ..model.mechanism import Mechanism, Prismatic
 from .tables import column_unit
 
 __all__ = ["ColumnWords", "describe_column", "link_role", "input_word", "unit_for_people", "subscript",
-           "position_caption", "trajectory_note", "CAPTION_CHARS", "COMPACT_CHARS"]
+           "position_caption", "position_head", "speed_words", "table_span", "plain", "trajectory_note", "CAPTION_CHARS",
+           "COMPACT_CHARS"]
 
 
 @dataclass(frozen=True)
@@ -291,6 +292,79 @@ def _per_input(mechanism: Mechanism | None, order: int, quantity: str) -> tuple[
 # ----------------------------------------------------------------------------------------------
 
 
+def plain(value: float, spec: str) -> str:
+    """``format(value, spec)`` without a minus on a value that rounds to zero ("0.0", never
+    "-0.0").
+
+    >>> plain(-0.01, ".1f"), plain(-0.0, ".4g"), plain(-2.5, ".1f")
+    ('0.0', '0', '-2.5')
+    """
+    text = format(value, spec)
+    return text[1:] if text.startswith("-") and not any(c in "123456789" for c in text.split("e")[0]) else text
+
+
+def _closed_turn(motion) -> bool:
+    """Whether the table's last row is its first a turn later (a crank's table over 360°)."""
+    phi = np.asarray(motion.phi, dtype=float)
+    return (motion.mechanism.coordinate.is_angle and len(phi) > 2
+            and abs(abs(phi[-1] - phi[0]) - 2 * np.pi) < 1e-9)
+
+
+def speed_words(motion) -> str:
+    """At what speed a kinetostatic analysis was made: "no speed given: static reactions, without
+    inertia forces", "at ω = 10 rad/s" or "at ω from 9.5 to 10.5 rad/s" (of the input)."""
+    omega = motion.omega
+    if omega is None or not np.any(np.isfinite(omega) & (omega != 0)):
+        return "no speed given: static reactions, without inertia forces"
+    finite = omega[np.isfinite(omega)]
+    unit = "rad/s" if motion.mechanism.coordinate.is_angle else "m/s"
+    what = "ω" if motion.mechanism.coordinate.is_angle else "v"
+    if np.ptp(finite) <= 1e-12 * np.max(np.abs(finite)):
+        return f"at {what} = {plain(float(finite[0]), '.5g')} {unit}".replace("-", "−")
+    return (f"at {what} from {plain(float(finite.min()), '.4g')} to {plain(float(finite.max()), '.4g')} "
+            f"{unit}").replace("-", "−")
+
+
+def position_head(motion, i: int) -> str:
+    """"Position i of n": n the distinct positions of the table (12 for a table of 13 rows over a
+    turn, whose row 13 is position 1 a turn later).
+
+    >>> import linkage
+    >>> mech = linkage.load("four_bar")
+    >>> motion = linkage.analyze(mech, linkage.table_angles(mech, 12))
+    >>> position_head(motion, 0), position_head(motion, 3), position_head(motion, 12)
+    ('Position 1 of 12', 'Position 4 of 12', 'Position 1 of 12, a turn later')
+    """
+    n = len(motion.phi)
+    if n == 1:
+        return f"Position {i + 1}"
+    if _closed_turn(motion):
+        return f"Position 1 of {n - 1}, a turn later" if i == n - 1 else f"Position {i + 1} of {n - 1}"
+    return f"Position {i + 1} of {n}"
+
+
+def table_span(motion) -> str:
+    """The table positions in words: "12 positions over a turn (13 = 1)" or "13 positions over
+    0.7 m of the input's slide" / "over 40.11° of the input's turn".
+
+    >>> import linkage
+    >>> mech = linkage.load("cylinder_boom")
+    >>> table_span(linkage.analyze(mech, linkage.table_angles(mech, 12)))
+    "13 table positions over 0.7 m of the cylinder's slide"
+    """
+    n = len(motion.phi)
+    if n == 1:
+        return "1 table position"
+    if _closed_turn(motion):
+        return f"{n - 1} table positions over a turn ({n} = 1)"
+    mech = motion.mechanism
+    if mech.coordinate.is_angle:
+        span = abs(float(table_positions_deg(motion.phi, motion.direction)[-1]))
+        return f"{n} table positions over {plain(span, '.4g')}° of the {input_word(mech)}'s turn"
+    span = abs(float(motion.phi[-1] - motion.phi[0]))
+    return f"{n} table positions over {plain(span, '.4g')} m of the {input_word(mech)}'s slide"
+
+
 def position_caption(motion, i: int, trajectories: Sequence[str] = (), compact: bool = False) -> str:
     """The position number and the input angle in words (and what the dashed lines are), in lines
     that fit above a drawing: :data:`CAPTION_CHARS` (:data:`COMPACT_CHARS` for a panel of a grid)."""
@@ -305,13 +379,12 @@ def position_caption(motion, i: int, trajectories: Sequence[str] = (), compact: 
     if absolute >= 359.95:
         absolute = 0.0
     who = "input link" if mech.input_range is not None else "crank"
-    of = f" of {len(motion.phi)}" if len(motion.phi) > 1 else ""
-    head = f"Position {i + 1}{of}"
-    at = f"φ = {absolute:.1f}°" if compact else f"φ = {absolute:.1f}° from the x axis"
-    if i == 0 or len(motion.phi) == 1:
+    head = position_head(motion, i)
+    at = f"φ = {plain(absolute, '.1f')}°" if compact else f"φ = {plain(absolute, '.1f')}° from the x axis"
+    if i == 0 or len(motion.phi) == 1 or plain(turned, ".4g") == "0":
         phrases = [f"{head}:", f"the {who} at {at}"]
     else:
-        phrases = [f"{head}:", f"the {who} turned {turned:.4g}°", sense, "from position 1", f"({at})"]
+        phrases = [f"{head}:", f"the {who} turned {plain(turned, '.4g')}°", sense, "from position 1", f"({at})"]
     return _wrapped_caption(mech, phrases, trajectories, compact)
 
 
@@ -320,16 +393,15 @@ def _slide_phrases(motion, i: int, compact: bool) -> list[str]:
     mech = motion.mechanism
     who = input_word(mech)
     s0, s = float(motion.phi[0]), float(motion.phi[i])
-    of = f" of {len(motion.phi)}" if len(motion.phi) > 1 else ""
-    head = f"Position {i + 1}{of}"
-    at = f"s = {s:.4g} m"
-    if i == 0 or len(motion.phi) == 1:
-        return [f"{head}:", f"the {who} at {at}"]
+    head = position_head(motion, i)
+    at = f"s = {plain(s, '.4g')} m"
     moved = s - s0
+    if i == 0 or len(motion.phi) == 1 or plain(moved, ".4g") == "0":
+        return [f"{head}:", f"the {who} at {at}"]
     if who == "cylinder":
         verb = "extended" if moved >= 0 else "retracted"
-        return [f"{head}:", f"the {who} {verb} by {abs(moved):.4g} m", "from position 1", f"({at})"]
-    return [f"{head}:", f"the {who} moved {abs(moved):.4g} m", "towards +s" if moved >= 0 else "towards −s",
+        return [f"{head}:", f"the {who} {verb} by {plain(abs(moved), '.4g')} m", "from position 1", f"({at})"]
+    return [f"{head}:", f"the {who} moved {plain(abs(moved), '.4g')} m", "towards +s" if moved >= 0 else "towards −s",
             "from position 1", f"({at})"]
 
 
