@@ -31,9 +31,10 @@ def add(sub) -> None:
                     "needs ezdxf (in the same extra): pip install \"linkage[report]\".")
     add_scheme_argument(p)
     p.add_argument("--out", "-o", metavar="DIR", required=True, help="the folder to write (created)")
-    p.add_argument("--position", "-i", metavar="I", type=whole(1, MAX_POSITIONS + 1), default=1,
+    p.add_argument("--position", "-i", metavar="I", type=whole(1, MAX_POSITIONS + 1), default=None,
                    help="the table position the plans, polygons and groups apart are drawn at, 1 .. N as in "
-                        "'linkage analyze' (default 1)")
+                        "'linkage analyze' (default: where the output moves fastest; position 1 is an extreme "
+                        "position, where its velocity is 0)")
     p.add_argument("--format", "-f", metavar="LIST", default="pdf,dxf",
                    help="comma-separated formats among pdf, dxf, svg (default pdf,dxf)")
     add_speed_arguments(p, "input angular velocity for the kinetostatics sheet (default: the scheme's mean speed)")

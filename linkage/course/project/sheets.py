@@ -12,8 +12,11 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Sequence
 
+import numpy as np
+
 from ...errors import LinkageError
 from ...model.mechanism import Mechanism
+from ...report.results import kinematics_results
 from .dynamics_sheet import dynamics_sheet
 from .frame import TitleInfo, layout_problems
 from .kinematics_sheet import kinematics_sheet
@@ -21,7 +24,7 @@ from .kinetostatics_sheet import kinetostatics_sheet
 from .model import Drawing
 from .writers import write
 
-__all__ = ["SHEETS", "project_sheets", "write_project_sheets"]
+__all__ = ["SHEETS", "drawn_position", "project_sheets", "write_project_sheets"]
 
 #: the sheets of a course project, in order: name and what it shows
 SHEETS = (("kinematics", "Kinematic analysis"), ("kinetostatics", "Kinetostatic analysis"),
@@ -37,7 +40,23 @@ def _missing(mech: Mechanism, name: str) -> str | None:
     return None
 
 
-def project_sheets(mech: Mechanism, position: int = 1, paper: str = "A1", title: TitleInfo | None = None,
+def drawn_position(mech: Mechanism) -> int:
+    """The table position (1-based) the sheets draw by default: where the output moves fastest
+    (the largest first analog of the scheme's output among the assembled positions), so that the
+    plans and polygons are well proportioned -- position 1 is an extreme position, where the
+    output's velocity is 0. Position 1 when the scheme declares no output."""
+    if mech.output is None:
+        return 1
+    results = kinematics_results(mech)
+    analog = np.asarray(results.columns.get(f"{mech.output.quantity}'", ()), float)
+    ok = results.motion.status == 0
+    if not len(analog) or not ok.any():
+        return 1
+    speed = np.where(ok[:len(analog)], np.abs(analog), -np.inf)
+    return int(np.argmax(speed)) + 1
+
+
+def project_sheets(mech: Mechanism, position: int | None = None, paper: str = "A1", title: TitleInfo | None = None,
                    omega: float | None = None) -> tuple[list[tuple[str, Drawing]], list[str]]:
     """The sheets ``[(name, drawing)]`` of ``mech`` whose data it holds, numbered k of K, and a note
     for each sheet left out.
@@ -45,8 +64,9 @@ def project_sheets(mech: Mechanism, position: int = 1, paper: str = "A1", title:
     Parameters
     ----------
     mech : Mechanism
-    position : int
-        The table position (1-based) the plans, polygons and groups apart are drawn at.
+    position : int, optional
+        The table position (1-based) the plans, polygons and groups apart are drawn at (default
+        :func:`drawn_position`).
     paper : {"A1", "A2", "A3"}
     title : TitleInfo, optional
         The title block's texts (default: the scheme's name).
@@ -61,6 +81,7 @@ def project_sheets(mech: Mechanism, position: int = 1, paper: str = "A1", title:
         position does not exist ...).
     """
     title = title or TitleInfo(scheme=mech.name)
+    position = drawn_position(mech) if position is None else position
     notes = []
     wanted = []
     for name, what in SHEETS:
@@ -88,7 +109,7 @@ def project_sheets(mech: Mechanism, position: int = 1, paper: str = "A1", title:
     return made, notes
 
 
-def write_project_sheets(mech: Mechanism, out: str | Path, position: int = 1, formats: Sequence[str] = ("pdf", "dxf"),
+def write_project_sheets(mech: Mechanism, out: str | Path, position: int | None = None, formats: Sequence[str] = ("pdf", "dxf"),
                          paper: str = "A1", title: TitleInfo | None = None, omega: float | None = None
                          ) -> tuple[list[Path], list[str]]:
     """Write the sheets of :func:`project_sheets` into the folder ``out`` as
