@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import linkage
-from linkage.course.project.frame import layout_problems
+from linkage.course.project.frame import extent, layout_problems
 from linkage.course.project.kinematics_sheet import kinematics_sheet
 from linkage.course.project.model import Arrow, Circle, Line, Text
 from linkage.errors import InputError
@@ -98,6 +98,22 @@ def test_plan_vectors_times_scale_are_those_of_linkage_plans(sheets, linkage_run
             assert error < 0.005, (quantity, v["from"], v["to"], error)
             longest = max(longest, v["magnitude"] / mu)
         assert 30.0 <= longest <= 120.0        # readable: the longest vector between 30 (small box) and 120 mm
+
+
+@pytest.mark.parametrize("name", SCHEMES)
+def test_the_drawing_uses_the_sheet(sheets, name):
+    """The parts together span at least 70 % of the frame's inner width and height (the frame and
+    title block left out), and the positions drawing spans at least half of its box's smaller side."""
+    drawing = sheets[name]
+    fx0, fy0, fx1, fy1 = _region(drawing, "frame")
+    boxes = np.array([extent(drawing, item) for item in drawing.items if item.layer != "frame"])
+    assert np.max(boxes[:, 2]) - np.min(boxes[:, 0]) >= 0.7 * (fx1 - fx0)
+    assert np.max(boxes[:, 3]) - np.min(boxes[:, 1]) >= 0.7 * (fy1 - fy0)
+    mx0, my0, mx1, my1 = _region(drawing, "mechanism")
+    drawn = np.array([drawing.bounds(item) for item in drawing.items if item.layer in ("links", "positions")
+                      and _inside(drawing.bounds(item)[:2], (mx0, my0, mx1, my1))])
+    size = max(np.max(drawn[:, 2]) - np.min(drawn[:, 0]), np.max(drawn[:, 3]) - np.min(drawn[:, 1]))
+    assert size >= 0.5 * min(mx1 - mx0, my1 - my0)
 
 
 def test_a_slide_input_gets_the_sheet_without_plans_and_says_why(sheets):

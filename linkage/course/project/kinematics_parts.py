@@ -18,6 +18,7 @@ import numpy as np
 
 from ...kinetostatics.plans import POLE, Plan
 from ...report.drawing import Scene, rail_hatch, support
+from .frame import WIDTH_MARGIN
 from .model import STANDARD_MANTISSAS, Arrow, Circle, Drawing, Line, Text
 
 __all__ = ["Sketch", "fitting_scale", "LabelPlacer", "draw_scene", "scene_points", "plan_extent",
@@ -25,6 +26,8 @@ __all__ = ["Sketch", "fitting_scale", "LabelPlacer", "draw_scene", "scene_points
 
 #: digits as subscripts (DejaVu Sans has them; so does every CAD font used for DXF text)
 SUBSCRIPT = str.maketrans("0123456789", "₀₁₂₃₄₅₆₇₈₉")
+#: the clear gap a placed label keeps from the lines near it, mm
+CLEAR = 0.6
 
 
 def fitting_scale(span: float, room_mm: float) -> float:
@@ -106,14 +109,21 @@ class LabelPlacer:
     def avoid(self, box: Sequence[float]) -> None:
         self.taken.append(tuple(box))
 
-    def _free(self, b) -> bool:
+    def free(self, b, clear: float = CLEAR) -> bool:
+        """Whether the box ``b = (x0, y0, x1, y1)`` mm lies in the placer's box, off the texts
+        taken and ``clear`` mm or more off the marks (the box widened to the width DejaVu Sans
+        draws, :data:`~.frame.WIDTH_MARGIN`)."""
         x0, y0, x1, y1 = self.box
         if b[0] < x0 or b[1] < y0 or b[2] > x1 or b[3] > y1:
             return False
         if any(b[0] < t[2] and t[0] < b[2] and b[1] < t[3] and t[1] < b[3] for t in self.taken):
             return False
+        grow = (b[2] - b[0]) * (WIDTH_MARGIN - 1) / 2 + clear
         m = self.marks
-        return not np.any((m[:, 0] > b[0]) & (m[:, 0] < b[2]) & (m[:, 1] > b[1]) & (m[:, 1] < b[3]))
+        return not np.any((m[:, 0] > b[0] - grow) & (m[:, 0] < b[2] + grow) & (m[:, 1] > b[1] - clear)
+                          & (m[:, 1] < b[3] + clear))
+
+    _free = free
 
     def place(self, at: Sequence[float], text: str, height: float, rings: Sequence[float] = (1.2, 2.5, 4.5, 7.0),
               prefer: Sequence[float] | None = None, layer: str = "text") -> Text | None:
@@ -313,33 +323,155 @@ def draw_plan(drawing: Drawing, plan: Plan, i: int, view, pole: str, height: flo
 
 
 def draw_diagram(drawing: Drawing, view, x: np.ndarray, y: np.ndarray, *, x_label: str, y_label: str,
-                 title: str, height: float, ticks: Sequence[tuple[float, str]] = (), width: float = 1e9) -> None:
+                 title: str, height: float, ticks: Sequence[tuple[float, str]] = (), width: float = 1e9,
+                 small: float = 2.5) -> None:
     """A curve ``y(x)`` through ``view`` (both scales) with its axes from the origin of ``view``
-    (x from its smallest to largest value, y over the curve's range and 0), the axes' names, the
-    table positions' ticks ``(x, label)`` and the title above (lines at most ``width`` mm)."""
+    (x from its smallest to largest value, y over the curve's range and 0), the axes' names (with
+    units), value ticks numbered on the y axis, the table positions' ticks ``(x, label)`` numbered
+    on the x axis on the side the curve leaves free, and the title above (lines at most ``width``
+    mm, text ``height`` mm; the numbers ``small`` mm)."""
     ok = np.isfinite(x) & np.isfinite(y)
     xs, ys = x[ok], y[ok]
     lo, hi = min(float(ys.min()), 0.0), max(float(ys.max()), 0.0)
     (ax0, ay_lo), (ax1, ay_hi) = view.paper((float(xs.min()), lo)), view.paper((float(xs.max()), hi))
     _, y0 = view.paper((0.0, 0.0))
     x_end = ax1 + 6.0
-    drawing.add(Line(((ax0, y0), (x_end, y0)), layer="diagrams", width=0.35))
-    drawing.add(Line(((ax0, ay_lo - 2.0), (ax0, ay_hi + 6.0)), layer="diagrams", width=0.35))
-    drawing.add(Line(((x_end - 2.5, y0 + 0.8), (x_end, y0), (x_end - 2.5, y0 - 0.8)), layer="diagrams", width=0.35))
     top = ay_hi + 6.0
+    drawing.add(Line(((ax0, y0), (x_end, y0)), layer="diagrams", width=0.35))
+    drawing.add(Line(((ax0, ay_lo - 2.0), (ax0, top)), layer="diagrams", width=0.35))
+    drawing.add(Line(((x_end - 2.5, y0 + 0.8), (x_end, y0), (x_end - 2.5, y0 - 0.8)), layer="diagrams", width=0.35))
     drawing.add(Line(((ax0 - 0.8, top - 2.5), (ax0, top), (ax0 + 0.8, top - 2.5)), layer="diagrams", width=0.35))
     segments = np.split(np.arange(len(x)), np.flatnonzero(~ok) + 1)
+    curve = []
     for seg in segments:
         seg = seg[ok[seg]]
         if len(seg) >= 2:
-            view.line(np.column_stack([x[seg], y[seg]]), layer="diagrams", width=0.5)
+            curve.append(view.line(np.column_stack([x[seg], y[seg]]), layer="diagrams", width=0.6))
     drawing.add(Text((x_end + 1.0, y0), x_label, height=height, anchor=("left", "middle")))
-    drawing.add(Text((ax0 + 1.5, top), y_label, height=height, anchor=("left", "top")))
-    longest = max(len(line) for line in title.split("\n"))
-    drawing.add(Text((ax0, top + 2.0), title, height=min(height, width / (0.7 * longest)), anchor=("left", "bottom")))
-    below = y0 - 1.5 if y0 - ay_lo < 2 * height + 2 else None
+    left = ax0 - 3.5 * small - 3.0
+    fit = lambda text: min(height, width / (0.7 * WIDTH_MARGIN * max(len(line) for line in text.split("\n"))))  # noqa: E731
+    label = drawing.add(Text((left, top + 1.5), y_label, height=fit(y_label), anchor=("left", "bottom")))
+    drawing.add(Text((left, label.box()[3] + 0.6 * height), title, height=fit(title), anchor=("left", "bottom")))
+    for value in value_ticks(lo, hi, view.scale_y.value if view.scale_y else view.scale.value):
+        _, py = view.paper((float(xs.min()), value))
+        drawing.add(Line(((ax0 - 1.2, py), (ax0, py)), layer="diagrams", width=0.25))
+        if abs(py - y0) > 0.5 * small or value == 0:
+            drawing.add(Text((ax0 - 1.8, py), _number(value), height=small, anchor=("right", "middle")))
+    pts = np.vstack([ln.points for ln in curve]) if curve else np.zeros((0, 2))
+    room = small + 2.2                     # a tick number's height with its gaps, mm
+    ends: dict[int, float] = {}            # the right end of the last number above (1) and below (-1)
     for xt, label in ticks:
         px, _ = view.paper((xt, 0.0))
         drawing.add(Line(((px, y0 - 1.0), (px, y0 + 1.0)), layer="diagrams", width=0.25))
-        if label and below is not None:
-            drawing.add(Text((px, below), label, height=0.7 * height, anchor=("center", "top")))
+        if not label:
+            continue
+        half = 0.35 * WIDTH_MARGIN * small * len(label) + 0.8
+        near = pts[np.abs(pts[:, 0] - px) <= half] if len(pts) else pts
+        below = near[(near[:, 1] <= y0) & (near[:, 1] >= y0 - room)] if len(near) else near
+        above = near[(near[:, 1] >= y0) & (near[:, 1] <= y0 + room)] if len(near) else near
+        if len(below) == 0 or (len(above) and len(below) and
+                               np.min(y0 - below[:, 1]) >= np.min(above[:, 1] - y0)):
+            side, item = -1, Text((px, y0 - 1.5), label, height=small, anchor=("center", "top"))
+        else:
+            side, item = 1, Text((px, y0 + 1.5), label, height=small, anchor=("center", "bottom"))
+        if px - half < ends.get(side, -np.inf):    # too near the last number on that side: left out
+            continue
+        ends[side] = px + half
+        drawing.add(item)
+
+
+def value_ticks(lo: float, hi: float, scale: float, spacing_mm: float = 15.0) -> list[float]:
+    """Round values (1, 2, 2.5, 5 x 10^n apart, about ``spacing_mm`` or more of paper at
+    ``scale`` units per mm) from ``lo`` to ``hi``, 0 among them when it is in the range."""
+    if not (hi > lo):
+        return [0.0]
+    raw = spacing_mm * scale
+    exponent = math.floor(math.log10(raw))
+    step = next(m * 10.0 ** exponent for m in (1.0, 2.0, 2.5, 5.0, 10.0) if m * 10.0 ** exponent >= raw * (1 - 1e-9))
+    first = math.ceil(lo / step - 1e-9)
+    last = math.floor(hi / step + 1e-9)
+    return [float(f"{k * step:.12g}") for k in range(first, last + 1)]
+
+
+def _number(value: float) -> str:
+    """A tick's value, short: 0.05, −1.2, 250 (a minus sign)."""
+    text = f"{value:.4g}"
+    return text.replace("-", "−") if value else "0"
+
+
+def spread(desired: Sequence[float], sizes: Sequence[float]) -> np.ndarray:
+    """Centres as near ``desired`` (sorted ascending) as they can be with neighbours at least
+    the mean of their ``sizes`` apart (labels along a line; least squares per packed run)."""
+    desired = np.asarray(desired, float)
+    sizes = np.asarray(sizes, float)
+    gaps = (sizes[:-1] + sizes[1:]) / 2
+    offset = np.concatenate([[0.0], np.cumsum(gaps)])      # packed positions relative to the first
+    runs: list[list] = []                                  # [first index, last index, first's centre]
+    for i, d in enumerate(desired):
+        runs.append([i, i, d])
+        while len(runs) > 1:
+            a, b = runs[-2], runs[-1]
+            if b[2] - (a[2] + offset[b[0]] - offset[a[0]]) >= -1e-9:
+                break
+            idx = np.arange(a[0], b[1] + 1)
+            runs[-2:] = [[a[0], b[1], float(np.mean(desired[idx] - (offset[idx] - offset[a[0]])))]]
+    out = np.empty(len(desired))
+    for first, last, at in runs:
+        idx = np.arange(first, last + 1)
+        out[idx] = at + offset[idx] - offset[first]
+    return out
+
+
+def leader(drawing: Drawing, point, box, gap: float = 0.9, least: float = 1.2) -> None:
+    """A thin leader from ``point`` (less ``gap`` mm) to the nearest point of the text ``box``,
+    when that is more than ``least`` mm away."""
+    p = np.asarray(point, float)
+    q = np.array([min(max(p[0], box[0]), box[2]), min(max(p[1], box[1]), box[3])])
+    d = float(np.hypot(*(q - p)))
+    if d <= least:
+        return
+    u = (q - p) / d
+    drawing.add(Line((tuple(p + gap * u), tuple(q - 0.4 * u)), layer="dimensions", width=0.18))
+
+
+def number_along_path(drawing: Drawing, placer: LabelPlacer, points: dict, sides: dict, height: float,
+                      normal: Sequence[float],
+                      offsets: Sequence[float] = (1.0, 1.8, 2.6, 3.6, 5.0, 7.0, 9.5, 12.0)) -> dict:
+    """Number the points of a path travelled back and forth (a slider's, a rocker's): the
+    labels ``{label: (x, y) mm}`` of side +1 in a row along ``normal`` (a unit vector across the
+    path), those of side -1 opposite, each row spread along the path so no two touch (:func:`spread`)
+    at the least offset (in text heights, ``offsets``) where the whole row is free, a leader from
+    each point to its label when they are apart. A label whose row finds no free place is placed
+    alone by ``placer``. Returns ``{side: the row's outer edge across the path, mm from the path's
+    centre line}``."""
+    n = np.asarray(normal, float) / np.hypot(*normal)
+    u = np.array([n[1], -n[0]])
+    pts = np.array(list(points.values()), float)
+    centre = pts.mean(axis=0)
+    edges = {}
+    for side in (1, -1):
+        labels = sorted((lab for lab in points if sides[lab] == side), key=lambda q: float(np.dot(points[q], u)))
+        if not labels:
+            continue
+        boxes = [Text((0.0, 0.0), lab, height=height, anchor=("center", "middle")).box() for lab in labels]
+        wide = [(b[2] - b[0]) * WIDTH_MARGIN for b in boxes]
+        tall = [b[3] - b[1] for b in boxes]
+        along = [abs(u[0]) * w + abs(u[1]) * t + 1.2 for w, t in zip(wide, tall)]
+        across = [abs(n[0]) * w + abs(n[1]) * t for w, t in zip(wide, tall)]
+        at = spread([float(np.dot(np.asarray(points[q]) - centre, u)) for q in labels], along)
+        base = max(side * float(np.dot(np.asarray(points[q]) - centre, n)) for q in labels)
+        for k in offsets:
+            items = [Text(tuple(centre + a * u + side * n * (base + k * height + c / 2)), lab, height=height,
+                          anchor=("center", "middle")) for lab, a, c in zip(labels, at, across)]
+            if all(placer.free(t.box()) for t in items):
+                for lab, t in zip(labels, items):
+                    placer.put(t)
+                    leader(drawing, points[lab], t.box())
+                edges[side] = base + k * height + max(across)
+                break
+        else:
+            for lab in labels:
+                t = placer.place(points[lab], lab, height, prefer=side * n, rings=(1.0, 2.0, 3.0, 4.5, 6.5, 9.0))
+                if t is not None:
+                    leader(drawing, points[lab], t.box())
+    return edges

@@ -36,16 +36,19 @@ from assur.base import OK
 from ...errors import InputError
 from ...kinematics.extremes import extreme_positions
 from ...kinematics.motion import Motion, analyze
+from ...kinetostatics.loads import CycleTable, StrokeDiagram, loads_of
 from ...kinetostatics.plans import Plans, build_plans
-from ...model.mechanism import Mechanism, Prismatic
+from ...model.mechanism import Mechanism, Prismatic, Revolute
 from ...model.scheme import section_of
 from ...report.animation import default_trajectories
 from ...report.drawing import Geometry
 from ...report.results import TableResults, analog_direction, kinematics_results
 from ...structure import mobility, structure_of
-from .frame import TitleInfo, blank_sheet, scales_table, table
+from .frame import WIDTH_MARGIN, TitleInfo, blank_sheet, scales_table, table
 from .kinematics_parts import (
     SUBSCRIPT,
+    leader,
+    number_along_path,
     LabelPlacer,
     Sketch,
     draw_diagram,
@@ -57,7 +60,7 @@ from .kinematics_parts import (
     scene_points,
     vector_name,
 )
-from .model import Drawing, Scale, Text, standard_scale
+from .model import Arrow, Drawing, Line, Scale, Text, standard_scale
 
 __all__ = ["KinematicsData", "kinematics_data", "kinematics_sheet", "SHEET_NAME"]
 
@@ -182,48 +185,70 @@ def kinematics_sheet(mech: Mechanism, position: int = 1, paper: str = "A1",
     if not title.scheme:
         title = TitleInfo(title.project, mech.name, title.variant, title.student, title.group)
     drawing, free = blank_sheet(paper, title, SHEET_NAME, 1, 3)
-    boxes = _layout(free, paper)
+    boxes = _layout(free, paper, data.plans is not None)
+    if data.plans is not None:               # the positions wider where that draws them larger
+        wider = _layout(free, paper, True, share=0.71)
+        if _fit_positions(data, wider["mechanism"], boxes["text"])[0] < _fit_positions(
+                data, boxes["mechanism"], boxes["text"])[0]:
+            boxes = wider
     h = boxes["text"]
     _structure(drawing, data, boxes["structure"], h)
     mu_l = _positions(drawing, data, boxes["mechanism"], h)
     measured = _plans(drawing, data, boxes, h)
     _diagrams(drawing, data, boxes["diagrams"], h)
-    x0, _, x1, y1 = boxes["tables"]
+    x0, y0, x1, y1 = boxes["tables"]
     box = scales_table(drawing, (x0, y1), height=h)
-    top = box[1] - 2 * h
-    if measured is not None:
-        top = _comparison(drawing, data, measured, mu_l, (x0, top), x1 - x0, h)[1] - 2 * h
-    _notes(drawing, data, (x0, boxes["tables"][1], x1, top), h)
+    bottom = y0
+    if measured is not None:                     # the comparison stands on the title block
+        bottom = _comparison(drawing, data, measured, mu_l, (x0, y0), x1 - x0, h)[3] + 2 * h
+    _notes(drawing, data, (x0, bottom, x1, box[1] - 2 * h), h)
     return drawing
 
 
-def _layout(free, paper: str) -> dict:
-    """The boxes of the sheet's parts (mm) inside the frame's free box."""
+def _layout(free, paper: str, plans: bool, share: float = 0.63) -> dict:
+    """The boxes of the sheet's parts (mm) inside the frame's free box: the diagrams along the
+    bottom (0.3 of the height) left of the title block, above them the structural diagram over
+    the mechanism in its positions on the left and the plans right of them, the tables in the
+    column above the title block; the left part takes ``share`` of the width. Without plans the
+    positions take the plans' width too and
+    the note on the plans sits beside the structural diagram."""
     fx0, fy0, fx1, fy1 = free
-    width, height = fx1 - fx0, fy1 - fy0
+    height = fy1 - fy0
     g = 6.0 if paper in ("A1", "A2") else 4.0
     right = fx1 - 185.0
-    bottom = fy0 + 0.30 * height
-    upper_h = fy1 - g - (bottom + g)
-    split = fx0 + g + 0.56 * (right - g - fx0 - g)
-    struct_y = fy1 - g - 0.34 * upper_h
-    plan_y = bottom + g + 0.5 * upper_h
-    return {"text": 3.5 if paper in ("A1", "A2") else 2.5,
-            "structure": (fx0 + g, struct_y + g / 2, split - g / 2, fy1 - g),
-            "mechanism": (fx0 + g, bottom + g, split - g / 2, struct_y - g / 2),
-            "velocity plan": (split + g / 2, plan_y + g / 2, right - g, fy1 - g),
-            "acceleration plan": (split + g / 2, bottom + g, right - g, plan_y - g / 2),
-            "diagrams": (fx0 + g, fy0 + g, right - g, bottom),
-            "tables": (right + 1.0, fy0 + 55.0 + g, fx1 - 1.0, fy1 - g)}
+    diagrams_top = fy0 + 0.30 * height
+    x0, x1 = fx0 + g, right - g
+    upper0, upper1 = diagrams_top + g, fy1 - g
+    struct_y = upper1 - (0.30 if plans else 0.22) * (upper1 - upper0)
+    split = x0 + share * (x1 - x0)
+    boxes = {"text": 3.5 if paper == "A1" else 2.5,
+             "structure": (x0, struct_y, split - g / 2, upper1),
+             "diagrams": (x0, fy0 + g, x1, diagrams_top),
+             "tables": (right + 1.0, fy0 + 55.0 + g, fx1 - 1.0, upper1)}
+    if plans:
+        middle = (upper0 + upper1) / 2
+        boxes["mechanism"] = (x0, upper0, split - g / 2, struct_y - g)
+        boxes["velocity plan"] = (split + g / 2, middle + g / 2, x1, upper1)
+        boxes["acceleration plan"] = (split + g / 2, upper0, x1, middle - g / 2)
+    else:
+        boxes["mechanism"] = (x0, upper0, x1, struct_y - g)
+        boxes["plans"] = (split + g / 2, struct_y, x1, upper1)
+    return boxes
 
 
 def _heading(drawing: Drawing, box, text: str, h: float) -> float:
     """A part's heading at the top left of its box, 1.3 h high or less to fit the box's width;
     returns the y under it (mm)."""
-    height = min(1.3 * h, (box[2] - box[0] - 2.0) / (0.7 * max(len(text), 1)))
+    big = heading_height(h)
+    height = min(big, (box[2] - box[0] - 2.0) / (0.7 * WIDTH_MARGIN * max(len(text), 1)))
     if text:
         drawing.add(Text((box[0] + 1.0, box[3] - 1.0), text, height=height, anchor=("left", "top")))
-    return box[3] - 1.0 - 1.3 * h - 3.0
+    return box[3] - 1.0 - big - 3.0
+
+
+def heading_height(h: float) -> float:
+    """A heading's text height (mm) on a sheet whose text is ``h`` mm: 5 on A1, 3.5 on the smaller papers."""
+    return 5.0 if h >= 3.5 else 3.5
 
 
 # the structural diagram ---------------------------------------------------------------------
@@ -242,7 +267,7 @@ def _structure(drawing: Drawing, data: KinematicsData, box, h: float) -> None:
     span = np.ptp(pts, axis=0)
     room = (sketch_box[2] - sketch_box[0] - 6 * h, sketch_box[3] - sketch_box[1] - 6 * h)
     factor = min(room[0] / max(span[0], 1e-9), room[1] / max(span[1], 1e-9))
-    unit_mm = 3.0 if h >= 3.5 else 2.2
+    unit_mm = 4.5 if h >= 3.5 else 3.0
     geometry.unit = unit_mm / factor
     scene = geometry.scene(data.index)
     pts = scene_points(scene, geometry.unit)
@@ -250,28 +275,28 @@ def _structure(drawing: Drawing, data: KinematicsData, box, h: float) -> None:
     factor = min(room[0] / max(hi[0] - lo[0], 1e-9), room[1] / max(hi[1] - lo[1], 1e-9))
     centre = (lo + hi) / 2
     sketch = Sketch(((sketch_box[0] + sketch_box[2]) / 2, (sketch_box[1] + sketch_box[3]) / 2), tuple(centre), factor)
-    pins = draw_scene(drawing, scene, sketch, geometry.unit, layer="links", width=0.5, pin_mm=1.2)
+    pins = draw_scene(drawing, scene, sketch, geometry.unit, layer="links", width=0.6, pin_mm=1.5)
     placer = LabelPlacer(drawing, sketch_box)
     placer.avoid_lines()
     middle = np.array(sketch.origin)
     for name, xy in pins:
-        placer.avoid((xy[0] - 1.3, xy[1] - 1.3, xy[0] + 1.3, xy[1] + 1.3))
+        placer.avoid((xy[0] - 2.0, xy[1] - 2.0, xy[0] + 2.0, xy[1] + 2.0))
     for name, xy in pins:
-        placer.place(xy, name, h, prefer=np.asarray(xy) - middle)
+        placer.place(xy, name, h, prefer=np.asarray(xy) - middle, rings=(1.0, 1.6, 2.5, 4.0, 6.0))
     for pair in mech.pairs.values():          # prismatic pairs lettered at their blocks
         if isinstance(pair, Prismatic):
             slider = pair.links[1]
             for link, centre_m, _, _ in scene.blocks:
                 if link == slider:
                     xy = sketch.paper(centre_m)
-                    placer.place(xy, pair.name, h, rings=(2.0, 3.0, 4.5, 6.5), prefer=np.asarray(xy) - middle)
+                    placer.place(xy, pair.name, h, rings=(2.5, 3.5, 5.0, 7.0, 9.5), prefer=np.asarray(xy) - middle)
                     break
     for link, poly in scene.bodies:           # link numbers beside their middles
         mid = sketch.paper(np.mean(poly, axis=0))
-        placer.place(mid, link, 1.15 * h, rings=(0.6, 1.2, 2.0, 3.0))
+        placer.place(mid, link, 1.15 * h, rings=(0.8, 1.4, 2.2, 3.2, 4.5))
     for link, centre_m, _, _ in scene.blocks:
         if not any(b[0] == link for b in scene.bodies):
-            placer.place(sketch.paper(centre_m), link, 1.15 * h, rings=(1.8, 2.6, 3.6))
+            placer.place(sketch.paper(centre_m), link, 1.15 * h, rings=(2.2, 3.0, 4.0, 5.5))
     # the structural analysis, as a student writes it
     structure = structure_of(mech)
     n, p = len(mech.moving_links), len(mech.pairs)
@@ -357,32 +382,21 @@ def _label_point(mech: Mechanism) -> str:
 
 
 def _positions(drawing: Drawing, data: KinematicsData, box, h: float) -> float:
-    """The mechanism at the table positions, superimposed, at μ_l; returns μ_l (m/mm)."""
+    """The mechanism at the table positions, superimposed, at the largest standard μ_l whose
+    drawing fits ``box``, its strokes marked; returns μ_l (m/mm)."""
     drawing.region("mechanism", box)
     mech, motion = data.mech, data.motion
     label_point = _label_point(mech)
-    traced = list(dict.fromkeys([_label_point(mech)] + default_trajectories(mech)))
+    traced = list(dict.fromkeys([label_point] + default_trajectories(mech)))
     extreme_motion = data.sweep
-    x0, y0, x1, _ = box
-    top = _heading(drawing, box, "", h)
-    room = (x1 - x0 - 16 * h, top - 5 * h - y0 - 8 * h)
-    unit_mm = 3.0 if h >= 3.5 else 2.2
-    geometry = Geometry(motion, data.rows, traced)
-    mu = fitting_scale(geometry.span, min(room))
-    for _ in range(6):
-        geometry.unit = unit_mm * mu
-        scenes = {k: geometry.scene(k) for k in data.rows}
-        pts = np.vstack([scene_points(s, geometry.unit) for s in scenes.values()])
-        lo, hi = pts.min(axis=0), pts.max(axis=0)
-        better = max(fitting_scale(hi[0] - lo[0], room[0]), fitting_scale(hi[1] - lo[1], room[1]))
-        if better <= mu:
-            break
-        mu = better
+    x0, y0, x1, top = _positions_room(box, h)
+    legend_h = 3 * 1.6 * h + 2.0
+    mu, geometry, scenes, lo, hi = _fit_positions(data, box, h)
     scale = Scale("μ_l", mu, "m/mm")
     _heading(drawing, box, f"The mechanism in its {len(data.rows)} table positions, μ_l = {mu:g} m/mm; "
                            f"position {data.index + 1} thick", h)
     centre = (lo + hi) / 2
-    origin = ((x0 + x1) / 2, (y0 + 5 * h + top) / 2)
+    origin = ((x0 + x1) / 2, (y0 + legend_h + top) / 2)
     view = drawing.view(scale, origin=origin, at=tuple(centre))
     for k in data.rows:
         if k != data.index:
@@ -400,36 +414,207 @@ def _positions(drawing: Drawing, data: KinematicsData, box, h: float) -> float:
         ok = np.all(np.isfinite(curve), axis=1)
         if ok.sum() >= 2:
             view.line(curve[ok], layer="trajectories", width=0.25, dashed=True)
-    placer = LabelPlacer(drawing, (x0, y0 + 5 * h, x1, top))
+    placer = LabelPlacer(drawing, (x0, y0 + legend_h, x1, top))
     placer.avoid_lines()
+    strokes = stroke_senses(data)
     p_label = {k: view.paper(motion.point(label_point)[k]) for k in data.rows}
-    path = np.array(list(p_label.values()))
-    middle = path.mean(axis=0) if len(path) else np.zeros(2)
     for xy in p_label.values():
         placer.avoid((xy[0] - 0.8, xy[1] - 0.8, xy[0] + 0.8, xy[1] + 0.8))
-    spread = np.linalg.svd(path - middle, full_matrices=False)[1] if len(path) > 1 else np.ones(2)
-    normal = np.linalg.svd(path - middle, full_matrices=False)[2][-1] if len(path) > 1 else np.array([0.0, 1.0])
-    for n, (k, xy) in enumerate(p_label.items()):
-        away = np.asarray(xy) - middle
-        if spread[-1] < 0.05 * spread[0] or np.hypot(*away) < 1e-6:     # a path on a line: either side
-            away = normal * (1 if n % 2 == 0 else -1)
-        placer.place(xy, str(k + 1), h, prefer=away, rings=(0.8, 1.6, 2.6, 4.0, 6.0, 8.5))
+    for name, xy in [(n, view.paper(p)) for n, p in chosen.points.items()]:   # the chosen position's points
+        placer.place(xy, name, 0.9 * h, rings=(0.8, 1.5, 2.4))
+    sweep_path = np.array([view.paper(p) for p in extreme_motion.point(label_point)
+                           if np.all(np.isfinite(p))])
+    to_and_fro = strokes is not None and _retraced(sweep_path)
+    if to_and_fro:
+        normal = _across(sweep_path)
+        numbers = {str(k + 1): p_label[k] for k in data.rows}
+        sides = {str(k + 1): (1 if strokes["leaving"][k] == strokes["working"] else -1) for k in data.rows}
+        edges = number_along_path(drawing, placer, numbers, sides, h, normal)
+        _stroke_arrows(drawing, data, view, label_point, strokes, normal, edges, placer, h)
+    else:
+        path = np.array(list(p_label.values()))
+        middle = path.mean(axis=0) if len(path) else np.zeros(2)
+        for k, xy in p_label.items():
+            t = placer.place(xy, str(k + 1), h, prefer=np.asarray(xy) - middle, rings=(0.8, 1.6, 2.6, 4.0, 6.0, 8.5))
+            if t is not None:
+                leader(drawing, xy, t.box())
     for key, row in data.extremes.items():
         xy = view.paper(extreme_motion.point(label_point)[row])
-        placer.place(xy, f"{label_point}{'′' if key == 'max' else '″'}", h, rings=(1.0, 2.0, 3.5, 5.0, 7.0))
-    for name, xy in [(n, view.paper(p)) for n, p in chosen.points.items()]:
-        placer.place(xy, name, 0.9 * h, rings=(0.7, 1.4, 2.4))
+        t = placer.place(xy, f"{label_point}{'′' if key == 'max' else '″'}", h, rings=(1.0, 2.0, 3.5, 5.0, 7.0, 9.0))
+        if t is not None:
+            leader(drawing, xy, t.box())
+    if strokes is not None and mech.coordinate.is_angle and mech.input_range is None:
+        _crank_arcs(drawing, data, view, strokes, placer, h)
     legend = [f"Numbers 1–{len(data.rows)}: the table positions at point {label_point} (position 1: the "
               f"{_start_words(data)}), in the direction of rotation."]
     if data.extremes:
         legend.append(f"Dashed: the extreme positions of the output {mech.output.quantity} ({label_point}′ max, "
                       f"{label_point}″ min); thin dashed: trajectories of {', '.join(traced)}.")
-    _paragraph(drawing, (x0 + 1.0, y0, x1, y0 + 4.8 * h), legend, 0.8 * h)
+    if strokes is not None:
+        side = " (numbers on the working stroke's side of the path, the idle stroke's opposite)" if to_and_fro else ""
+        sense = "increasing" if strokes["working"] > 0 else "decreasing"
+        legend.append(f"Working stroke: {mech.output.quantity} {sense}"
+                      f", {strokes['why']}{side}.")
+    _paragraph(drawing, (x0 + 1.0, y0, x1, y0 + legend_h), legend, h)
     return mu
 
 
-def _dashed(points, closed: bool):
-    from .model import Line
+def _positions_room(box, h: float) -> tuple[float, float, float, float]:
+    """The part of the positions' box (mm) under its heading."""
+    return (box[0], box[1], box[2], box[3] - 1.0 - heading_height(h) - 3.0)
+
+
+def _fit_positions(data: KinematicsData, box, h: float):
+    """The largest standard μ_l (m/mm) at which the positions (with their symbols, guides and
+    trajectories) fit ``box`` less the heading, the legend and a margin for the labels; returns
+    μ_l, the geometry, the scenes of the rows and the drawing's extent (lo, hi; m)."""
+    x0, y0, x1, top = _positions_room(box, h)
+    room = (x1 - x0 - 2 * 4 * h, top - y0 - (3 * 1.6 * h + 2.0) - 2 * 3 * h)
+    traced = list(dict.fromkeys([_label_point(data.mech)] + default_trajectories(data.mech)))
+    geometry = Geometry(data.motion, data.rows, traced)
+    mu = fitting_scale(geometry.span, min(room))
+    seen = []
+    for _ in range(8):
+        geometry.unit = (3.0 if h >= 3.5 else 2.2) * mu
+        scenes = {k: geometry.scene(k) for k in data.rows}
+        pts = np.vstack([scene_points(s, geometry.unit) for s in scenes.values()])
+        lo, hi = pts.min(axis=0), pts.max(axis=0)
+        fits = max(fitting_scale(hi[0] - lo[0], room[0]), fitting_scale(hi[1] - lo[1], room[1]))
+        if fits == mu or fits in seen:
+            mu = max(mu, fits)
+            if fits != mu:
+                continue
+            break
+        seen.append(mu)
+        mu = fits
+    geometry.unit = (3.0 if h >= 3.5 else 2.2) * mu
+    scenes = {k: geometry.scene(k) for k in data.rows}
+    pts = np.vstack([scene_points(s, geometry.unit) for s in scenes.values()])
+    return mu, geometry, scenes, pts.min(axis=0), pts.max(axis=0)
+
+
+def _retraced(path: np.ndarray) -> bool:
+    """Whether a closed trajectory (mm) runs back over itself (a slider's, a rocker's point): the
+    area it encloses is under 2 % of its extent squared."""
+    if len(path) < 3:
+        return True
+    x, y = path[:, 0], path[:, 1]
+    area = 0.5 * abs(float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))))
+    extent = float(np.max(np.ptp(path, axis=0)))
+    return area <= 0.02 * extent ** 2
+
+
+def _across(path: np.ndarray) -> np.ndarray:
+    """The unit vector across a path (mm): normal to its principal direction, pointing up (or right)."""
+    d = np.linalg.svd(path - path.mean(axis=0), full_matrices=False)[2][0]
+    n = np.array([-d[1], d[0]])
+    return n if (n[1] > 1e-9 or (abs(n[1]) <= 1e-9 and n[0] > 0)) else -n
+
+
+def stroke_senses(data: KinematicsData) -> dict | None:
+    """The output's strokes: ``working`` (+1: the output quantity increases on the working
+    stroke), ``why`` (words), ``leaving`` (the sense in which the output leaves each table
+    row, ±1), ``rows`` (the sweep's rows of the working stroke's start and end). None when the
+    output has no extremes on the table's travel."""
+    if set(data.extremes) != {"max", "min"}:
+        return None
+    mech, motion = data.mech, data.motion
+    q = motion.quantity(mech.output.quantity)[0]
+    full = mech.coordinate.is_angle and mech.input_range is None
+    nxt = np.concatenate([q[1:-1], q[:1], q[1:2]]) if full else np.concatenate([q[1:], [2 * q[-1] - q[-2]]])
+    change = np.where(np.isfinite(nxt - q), nxt - q, 0.0)
+    leaving = np.where(change >= 0, 1, -1)
+    working, why = None, ""
+    for f in getattr(loads_of(mech), "forces", ()):
+        load = f.force
+        if getattr(load, "quantity", None) != mech.output.quantity:
+            continue
+        if isinstance(load, StrokeDiagram):
+            working, why = int(load.working), "as the load diagram of [[loads.forces]] declares"
+        elif isinstance(load, CycleTable):
+            mag = np.abs(np.asarray(load.values, float))
+            peak = int(np.argmax(mag))
+            if peak > 0 and np.isfinite(q[peak % len(q)]) and np.isfinite(q[peak - 1]):
+                working = 1 if q[peak % len(q)] - q[peak - 1] >= 0 else -1
+                why = "where the useful resistance of [[loads.forces]] acts"
+        if working is not None:
+            break
+    if working is None:
+        rows = data.extremes
+        t = data.psi
+        up = abs(float(t[rows["max"]] - t[rows["min"]]))
+        up = up if rows["max"] > rows["min"] else abs(float(t[-1] - t[0])) - up
+        working = 1 if up >= abs(float(t[-1] - t[0])) - up else -1
+        why = "the slower stroke (the scheme declares no load on its output)"
+    start, end = ("min", "max") if working > 0 else ("max", "min")
+    return {"working": working, "why": why, "leaving": leaving,
+            "rows": (data.extremes[start], data.extremes[end])}
+
+
+def _stroke_arrows(drawing: Drawing, data: KinematicsData, view, point: str, strokes: dict, normal, edges: dict,
+                   placer, h: float) -> None:
+    """The working stroke's travel of the output point as an arrow beyond its numbers, the idle
+    stroke's opposite, each named with the output's stroke (m, or degrees for an angle)."""
+    path = data.sweep.point(point)
+    a, b = strokes["rows"]
+    pa, pb = np.array(view.paper(path[a])), np.array(view.paper(path[b]))
+    n = np.asarray(normal, float)
+    centre = np.mean([view.paper(p) for p in data.motion.point(point)[data.rows]], axis=0)
+    value = data.sweep.quantity(data.mech.output.quantity)[0]
+    stroke = abs(float(value[data.extremes["max"]] - value[data.extremes["min"]]))
+    size = f"{math.degrees(stroke):.1f}°" if data.mech.output.quantity.endswith(".theta") else f"H = {stroke:.4g} m"
+    for side, (s, e), words in ((1, (pa, pb), "working stroke"), (-1, (pb, pa), "idle stroke")):
+        off = edges.get(side, 2 * h) + 2.5
+        s_off = s + side * n * max(off + side * float(np.dot(centre - s, n)), off)
+        e_off = e + side * n * max(off + side * float(np.dot(centre - e, n)), off)
+        shift = (s_off - s + e_off - e) / 2
+        s_off, e_off = s + shift, e + shift
+        if np.hypot(*(e_off - s_off)) < 6.0:
+            continue
+        drawing.add(Arrow(tuple(s_off), tuple(e_off), layer="dimensions", width=0.35, head=3.0))
+        for p, q in ((s, s_off), (e, e_off)):
+            drawing.add(Line((tuple(p + (q - p) * 0.15), tuple(q + (q - p) / max(np.hypot(*(q - p)), 1e-9) * 1.5)),
+                             layer="dimensions", width=0.18))
+        mid = (s_off + e_off) / 2
+        placer.place(tuple(mid), f"{words}, {size}", h, prefer=side * n, rings=(0.5, 1.0, 1.8, 3.0))
+
+
+def _crank_arcs(drawing: Drawing, data: KinematicsData, view, strokes: dict, placer, h: float) -> None:
+    """Arcs about the crank's pivot over the crank angles of the working stroke (φ_w) and of the
+    idle stroke (φ_i), arrowed in the direction of rotation."""
+    mech, sweep = data.mech, data.sweep
+    crank = mech.inputs[0]
+    pins = [p for p in mech.pairs.values() if isinstance(p, Revolute) and crank in p.links]
+    pivot = next((p for p in pins if mech.frame in p.links), None)
+    tip = next((p for p in pins if mech.frame not in p.links), None)
+    if pivot is None or tip is None:
+        return
+    o = sweep.point(pivot.point)[0]
+    rel = sweep.point(tip.point) - o
+    angle = np.unwrap(np.arctan2(rel[:, 1], rel[:, 0]))
+    radius_mm = float(np.nanmax(np.hypot(rel[:, 0], rel[:, 1]))) / view.scale.value
+    last = len(angle) - 1
+    a, b = strokes["rows"]
+    spans = {"working": (a, b), "idle": (b, a)}
+    for k, (name, (r0, r1)) in enumerate(spans.items()):
+        rows = np.arange(r0, r1 + 1) if r1 >= r0 else np.concatenate([np.arange(r0, last), np.arange(0, r1 + 1)])
+        turned = np.unwrap(angle[rows])
+        sweep_deg = abs(math.degrees(float(turned[-1] - turned[0])))
+        if sweep_deg < 2.0:
+            continue
+        r = radius_mm + (6.0 + 5.0 * k) * (1.0 if h >= 3.5 else 0.8)
+        t = np.linspace(float(turned[0]), float(turned[-1]), max(8, int(sweep_deg / 3)))
+        centre = np.array(view.paper(o))
+        arc = centre + r * np.column_stack([np.cos(t), np.sin(t)])
+        drawing.add(Line(tuple(map(tuple, arc[:-1])), layer="dimensions", width=0.3))
+        drawing.add(Arrow(tuple(arc[-2]), tuple(arc[-1]), layer="dimensions", width=0.3, head=2.5))
+        mid = arc[len(arc) // 2]
+        symbol = "φ_w" if name == "working" else "φ_i"
+        placer.place(tuple(mid), f"{symbol} = {sweep_deg:.1f}°", 0.9 * h, prefer=mid - centre,
+                     rings=(0.4, 0.9, 1.6, 2.5, 4.0))
+
+
+def _dashed(points, closed: bool) -> Line:
     return Line(tuple(points), layer="positions", width=0.35, dashed=True, closed=closed)
 
 
@@ -448,11 +633,10 @@ def _start_words(data: KinematicsData) -> str:
 def _plans(drawing: Drawing, data: KinematicsData, boxes: dict, h: float) -> dict | None:
     """Both plans at the chosen position; returns the plan -> scale drawn (None without plans)."""
     if data.plans is None:
-        vb, ab = boxes["velocity plan"], boxes["acceleration plan"]
-        box = (vb[0], ab[1], vb[2], vb[3])
+        box = boxes["plans"]
         drawing.region("plans", box)
         _heading(drawing, box, "Plans of velocities and accelerations", h)
-        _paragraph(drawing, (box[0] + 1.0, box[1], box[2] - 1.0, box[3] - 4 * h),
+        _paragraph(drawing, (box[0] + 1.0, box[1], box[2] - 1.0, box[3] - heading_height(h) - 5.0),
                    [f"Not drawn: scheme '{data.mech.name}' is driven by a slide ({data.mech.inputs[0]}, m). "
                     "The plans start from a crank's angular velocity (rad/s); for a slide input see the diagrams "
                     "of the analogs per m of the slide below and `linkage analyze`."], h)
@@ -465,22 +649,25 @@ def _plans(drawing: Drawing, data: KinematicsData, boxes: dict, h: float) -> dic
         plan = getattr(data.plans, quantity)
         lo, hi, longest = plan_extent(plan, 0)
         x0, y0, x1, y1 = box
-        room = (x1 - x0 - 12 * h, y1 - y0 - 10 * h)
-        k = min(1.0, room[1] / 150.0, room[0] / 150.0)
+        room = (x1 - x0 - 8 * h, y1 - y0 - heading_height(h) - 8 * h)
+        k = min(1.0, room[1] / 130.0, room[0] / 130.0)
         mu = standard_scale(longest, 60.0 * min(k, 1.0), 120.0 * min(k, 1.0)) if longest > 0 else 1.0
         mu = max(mu, fitting_scale(hi[0] - lo[0], room[0]), fitting_scale(hi[1] - lo[1], room[1]))
         scale = Scale(symbol, mu, unit)
         plural = "velocities" if quantity == "velocity" else "accelerations"
         _heading(drawing, box, f"Plan of {plural}, position {data.index + 1}: {scale}", h)
-        view = drawing.view(scale, origin=((x0 + x1) / 2, (y0 + y1 - 3 * h) / 2), at=tuple((lo + hi) / 2))
-        draw_plan(drawing, plan, 0, view, pole, h, (x0, y0, x1, y1 - 3.5 * h))
+        top = y1 - heading_height(h) - 3.0
+        view = drawing.view(scale, origin=((x0 + x1) / 2, (y0 + top) / 2), at=tuple((lo + hi) / 2))
+        draw_plan(drawing, plan, 0, view, pole, h, (x0, y0, x1, top))
         scales[quantity] = mu
     return scales
 
 
-def _comparison(drawing: Drawing, data: KinematicsData, scales: dict, mu_l: float, top_left, width: float,
+def _comparison(drawing: Drawing, data: KinematicsData, scales: dict, mu_l: float, bottom_left, width: float,
                 h: float):
-    """The table of values by the plans against the analytic ones."""
+    """The table of values by the plans against the analytic ones, its heading over it, standing
+    on ``bottom_left`` (mm); its cells at the largest of 3.5, 3 and 2.5 mm its columns fit in
+    ``width``. Returns the box of the table and its heading."""
     plans, mech = data.plans, data.mech
     motion = analyze(mech, data.motion.phi[data.index:data.index + 1], order=2, omega=data.omega, eps=0.0)
     rows = []
@@ -518,12 +705,21 @@ def _comparison(drawing: Drawing, data: KinematicsData, scales: dict, mu_l: floa
                                  motion.second[link][0, 2] * data.omega ** 2))
             row(f"{symbol}{link.translate(SUBSCRIPT)} = {vector_name(vec, quantity)}/l_{vec.point}{vec.about}",
                 length, mu, analytic, unit_k, by_plan)
-    header = ["quantity", "length\non plan, mm", "by the\nplan", "analytic", "unit", "differ-\nence, %"]
-    widths = [w * width / 183.0 for w in (58.0, 25.0, 25.0, 25.0, 25.0, 25.0)]
-    drawing.add(Text((top_left[0], top_left[1]), f"Plans against the analytic values, position {data.index + 1}",
-                     height=h, anchor=("left", "top")))
-    return table(drawing, (top_left[0], top_left[1] - 1.6 * h - 1.0), header, rows, widths,
-                 height=2.5, name="comparison")
+    header = ["quantity", "length\non plan,\nmm", "by the\nplan", "analytic", "unit", "differ-\nence, %"]
+    for cell in (3.5, 3.0, 2.5) if h >= 3.5 else (2.5,):
+        need = [max(len(line) for text in [head] + [r[c] for r in rows] for line in text.split("\n"))
+                * 0.7 * WIDTH_MARGIN * cell + 2.0 for c, head in enumerate(header)]
+        if sum(need) <= width:
+            break
+    widths = [w + (width - sum(need)) * w / sum(need) for w in need]
+    row_h = 2 * cell + 1
+    tall = row_h + 1.6 * cell * 2 + row_h * len(rows)
+    x0, y0 = bottom_left
+    title = f"Plans against the analytic values, position {data.index + 1}"
+    heading = min(h, (width - 1.0) / (0.7 * WIDTH_MARGIN * len(title)))
+    drawing.add(Text((x0, y0 + tall + 1.0), title, height=heading, anchor=("left", "bottom")))
+    box = table(drawing, (x0, y0 + tall), header, rows, widths, height=cell, name="comparison")
+    return (box[0], box[1], box[2], box[3] + 1.0 + heading)
 
 
 def _notes(drawing: Drawing, data: KinematicsData, box, h: float) -> None:
@@ -536,7 +732,7 @@ def _notes(drawing: Drawing, data: KinematicsData, box, h: float) -> None:
     if box[3] - box[1] < 3 * h:
         return
     drawing.region("notes", box)
-    _paragraph(drawing, box, lines, 0.8 * h)
+    _paragraph(drawing, box, lines, h)
 
 
 # the diagrams ------------------------------------------------------------------------------
@@ -555,7 +751,9 @@ def _diagrams(drawing: Drawing, data: KinematicsData, box, h: float) -> None:
     x0, y0, x1, y1 = box
     gap = 8.0
     width = (x1 - x0 - 2 * gap) / 3
-    x_room = width - 18 * h
+    small = 2.5
+    left = 3.5 * small + 4.0                      # the y axis's numbers left of it, mm
+    x_room = width - left - 6.0 - 1.0 - 0.7 * WIDTH_MARGIN * h * 7
     if is_angle:
         x_scale = Scale("μ_φ", fitting_scale(x_span, x_room), "rad/mm")
         x_label, per = "ψ, rad", "rad"
@@ -583,13 +781,15 @@ def _diagrams(drawing: Drawing, data: KinematicsData, box, h: float) -> None:
         drawing.region(f"diagram {n + 1}", bbox)
         ok = np.isfinite(y)
         lo, hi = min(float(np.min(y[ok])), 0.0), max(float(np.max(y[ok])), 0.0)
-        y_room = (y1 - y0) - 9.5 * h - 12.0
+        text_h = 3 * 1.6 * h + 1.5 + 6.0          # the title, scales and axis name over the axis's arrow
+        y_room = (y1 - y0) - text_h - (small + 4.0) - 2.0
         y_scale = Scale(symbol, fitting_scale(hi - lo if hi > lo else 1.0, y_room), unit)
         xs0 = float(np.nanmin(x))
-        origin = (bx0 + 3.0, y0 + 3.0 + 1.6 * h + (0.0 - lo) / y_scale.value)
+        origin = (bx0 + left, y0 + small + 4.0 + (0.0 - lo) / y_scale.value)
         view = drawing.view(x_scale, origin=origin, at=(xs0, 0.0), scale_y=y_scale)
         draw_diagram(drawing, view, x, y, x_label=x_label, y_label=y_label,
-                     title=f"{title}\n{x_scale}, {y_scale}", height=0.8 * h, ticks=ticks, width=width - 4.0)
+                     title=f"{title}\n{x_scale}, {y_scale}", height=h, ticks=ticks, width=width - 2.0,
+                     small=small)
 
 
 def _per(out_unit: str, per: str, order: int) -> str:
