@@ -63,10 +63,10 @@ def test_polygon_vectors_to_scale(sheet):
                 assert v.length * mu_f == pytest.approx(expected, rel=5e-3)
                 checked += 1
     assert checked >= sum(len(p.forces) for p in plans.polygons) - 6
-    # one μ_F: the largest polygon's longest vector is 60..120 mm unless a polygon had to fit its place
+    # one μ_F: the largest polygon's longest vector is 100..200 mm unless a polygon had to fit its place
     longest = max(values.values()) / mu_f
-    assert longest <= 120.0 + 1e-9
-    assert longest >= 60.0 or any("fit" in n for n in sheet.notes)
+    assert longest <= 200.0 + 1e-9
+    assert longest >= 100.0 or any("fit" in n for n in sheet.notes)
 
 
 def test_split_reactions(sheet):
@@ -129,6 +129,23 @@ def test_layout(sheet):
     assert set(sheet.drawing.scales) == {"μ_l", "μ_F", "μ_v"}
     assert any(isinstance(item, Line) and item.layer == "forces" and not item.closed
                and len(item.points) > 10 for item in sheet.drawing.items), "a moment drawn as a curved arrow"
+
+
+def test_sheet_filled(sheet):
+    """The drawing fills the sheet: the union of its primitives' bounds (the frame and the title
+    block aside) covers at least 70 % of the frame's inner width and height, and every force
+    polygon is at least 40 mm across (its two farthest vertices)."""
+    drawing = sheet.drawing
+    x0, y0, x1, y1 = next(r.box for r in drawing.regions if r.name == "frame")
+    b0, b1, b2, b3 = next(r.box for r in drawing.regions if r.name == "title block")
+    boxes = np.array([box for box in (drawing.bounds(item) for item in drawing.items if item.layer != "frame")
+                      if not (box[0] >= b0 - 1e-6 and box[1] >= b1 - 1e-6 and box[2] <= b2 + 1e-6
+                              and box[3] <= b3 + 1e-6)])
+    covered = (boxes[:, 2].max() - boxes[:, 0].min(), boxes[:, 3].max() - boxes[:, 1].min())
+    assert covered[0] >= 0.7 * (x1 - x0) and covered[1] >= 0.7 * (y1 - y0)
+    for step in {v.step for v in sheet.vectors}:
+        ends = np.array([p for v in sheet.vectors if v.step == step for p in (v.start, v.end)])
+        assert np.hypot(*(ends[:, None, :] - ends[None, :, :]).transpose(2, 0, 1)).max() >= 40.0, step
 
 
 def test_group_drawn_at_mu_l(sheet):

@@ -1,100 +1,81 @@
 """The kinetostatics sheet of a course project: each Assur group drawn apart with its loads and
 reactions, the force polygons, Zhukovsky's lever and the check of the balancing moment.
 
-At one table position the sheet shows, row by row (the groups in the order they are solved, from
-the farthest, then the input links): the group drawn apart at the sheet's ``μ_l`` with its applied
+The A1 layout is the course's (METHOD §10). On the left, one row per Assur group in the order
+they are solved (from the farthest): the group drawn apart at the sheet's ``μ_l`` with its applied
 forces, gravity, inertia forces, inertia and applied moments (curved arrows with their values) and
-the reactions of its outer pairs; its force polygon at the sheet's one ``μ_F``; and a table of
-every polygon vector's length and value. An outer revolute pair of a dyad whose link meets the
-other link in a revolute pair has its reaction split as the course does (METHOD §10):
-``R = Rⁿ + Rτ``, ``Rτ`` across the link from the link's moment equation about the inner pair,
-``Rⁿ`` along the link from the group's polygon, which is drawn in the student's order (``Rτ``
-first, the loads, ``Rⁿ`` closing it) with the whole reactions as resultants. On the right:
-Zhukovsky's lever (the velocity plan turned 90° clockwise at ``μ_v``, the forces at the images
-of their points), its table of moments, a table comparing ``M_b`` by the polygons and by the
-lever, the scales and the notes.
+the reactions of its outer pairs, and its force polygon beside it at the sheet's one ``μ_F``;
+along the bottom the polygons' tables (every vector's length and value). On the right: the input
+link drawn apart with ``M_b`` and its polygon; Zhukovsky's lever (the velocity plan turned 90°
+clockwise at ``μ_v``, the forces at the images of their points); the lever's table of moments
+above the title block; the table comparing ``M_b`` by the polygons and by the lever, the scales
+and the notes. ``μ_l`` is the largest standard drawing at which every group fits its box (the
+largest at most 250 mm); ``μ_F`` draws the longest polygon vector 100–200 mm unless a polygon
+must be smaller to fit its box (a note says so).
+
+An outer revolute pair of a dyad whose link meets the other link in a revolute pair has its
+reaction split as the course does: ``R = Rⁿ + Rτ``, ``Rτ`` across the link from the link's moment
+equation about the inner pair, ``Rⁿ`` along the link from the group's polygon, which is drawn in
+the student's order (``Rτ`` first, the loads, ``Rⁿ`` closing it) with the whole reactions as
+resultants.
 
 Every number comes from :func:`linkage.kinetostatics.plans.build_plans` (the plans, polygons and
 lever of ``linkage plans``) at the positions of ``linkage forces``; the split is the only thing
-computed here. Arrows on the groups and on the lever give the lines and senses of the forces (not
-to scale); the polygons are to scale.
+computed here (:mod:`.kinetostatics_parts`). The forces on a group are drawn at ``μ_F`` when they
+all fit its box, else as arrows giving their lines and senses, not to scale (the group's heading
+says which); the lever's forces are never to scale.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import math
-import re
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from ...errors import InputError
 from ...kinematics.motion import table_positions_deg
-from ...kinetostatics.plans import POLE, ForcePolygon, Plans, PolygonForce, build_plans, require_crank_input
+from ...kinetostatics.plans import POLE, ForcePolygon, Plans
 from ...model.mechanism import Prismatic, Revolute
-from ...model.scheme import section_of
 from ...report.drawing import Geometry
 from ...report.plan_drawings import nice_scale
-from ...report.results import forces_results
-from .frame import TitleInfo, blank_sheet, scales_table, table
-from .model import Arrow, Circle, Drawing, Line, Scale, Text, standard_scale
+from .frame import CELL_PAD, TITLE_BLOCK_SIZE, WIDTH_MARGIN, TitleInfo, blank_sheet, scales_table, table
+from .kinetostatics_parts import (HEADING, LABEL, SUB, DrawnVector, Labels, ReactionSplit, analysis, force_point,
+                                  global_point, image, name, num, pair_point, split_reactions, unit, wrapped)
+from .model import Arrow, Circle, Drawing, Line, Scale, Text
 
 __all__ = ["DrawnVector", "ReactionSplit", "KinetostaticsSheet", "compose_kinetostatics", "kinetostatics_sheet",
            "split_reactions"]
 
-#: text heights: headings, labels, tables, mm
-HEADING, LABEL, SMALL = 5.0, 3.5, 2.5
+#: a box's title and the line under it, mm
+TITLE, SUBTITLE = 4.5, 3.5
+#: the text heights a table is tried at, largest first, mm
+TABLE_HEIGHTS = (3.5, 3.0, 2.5)
 #: a polygon vector shorter than this carries no label on the drawing (its table names it), mm
 LABELLED_MM = 4.0
-#: a force arrow on a group or on the lever: the shortest and longest, mm (not to scale)
-ARROW_MM = (9.0, 24.0)
-#: a polygon whose longest vector is shorter than this at the sheet's μ_F is called tiny in a note, mm
+#: a force arrow on a group or on the lever when not to scale: the shortest and longest, mm
+ARROW_MM = (12.0, 32.0)
+#: a polygon whose longest vector is shorter than this at the sheet's μ_F is called small in a note, mm
 TINY_MM = 20.0
-#: the room kept around a group for its arrows and labels, mm
-GROUP_MARGIN = 34.0
-
-
-@dataclass(frozen=True)
-class DrawnVector:
-    """A vector of a force polygon as drawn from ``start`` to ``end`` (mm; ``items``: its arrow, or
-    a dashed line and a head) standing for ``value`` ``(2,)``, N.
-
-    ``kind``: ``force`` (a force of :class:`~linkage.kinetostatics.plans.ForcePolygon`, ``label``
-    its label), ``internal`` (the reaction between the group's links), ``normal`` / ``tangential``
-    (the parts ``Rⁿ``, ``Rτ`` of a split reaction ``label``) or ``resultant`` (the whole split
-    reaction ``label`` drawn as their sum)."""
-
-    step: str
-    label: str
-    kind: str
-    start: tuple[float, float]
-    end: tuple[float, float]
-    value: np.ndarray
-    items: tuple = ()
-
-    @property
-    def length(self) -> float:
-        """The drawn length, mm."""
-        return math.hypot(self.end[0] - self.start[0], self.end[1] - self.start[1])
-
-
-@dataclass(frozen=True)
-class ReactionSplit:
-    """The reaction ``whole`` ``(2,)``, N, of an outer revolute ``pair`` (at ``point``, m) on
-    ``link`` of a dyad, as ``normal`` (along ``point`` -> ``inner_point``, the link's revolute
-    pair with the other link of the group) plus ``tangential`` (across), N."""
-
-    step: str
-    label: str
-    pair: str
-    link: str
-    inner_pair: str
-    point: np.ndarray
-    inner_point: np.ndarray
-    whole: np.ndarray
-    normal: np.ndarray
-    tangential: np.ndarray
+#: the room kept around a group for its arrows and labels; around a polygon for its labels, mm
+GROUP_MARGIN, POLYGON_MARGIN = 36.0, 12.0
+#: the largest drawn group; the longest polygon vector's range, mm
+GROUP_MM, POLYGON_MM = 250.0, (100.0, 200.0)
+#: the heights the input links' band is tried at, fractions of the right column's (the first that draws
+#: μ_l and μ_F largest)
+INPUT_BAND = (0.30, 0.36, 0.42)
+#: the lever's longest vector below which it is called small, mm
+LEVER_MM = 60.0
+#: the shares of the left column's width the groups beside their polygons are tried at
+GROUP_SHARE = (0.56, 0.62, 0.5)
+#: the shares of the right column's width the input link beside its polygon is tried at
+INPUT_SHARE = (0.5, 0.62)
+#: a force on a group within this angle of a link from its point is drawn ending at the point, degrees
+ALONG_DEG = 4.0
+#: the radius of a moment's curved arrow, mm
+MOMENT_RADIUS = 8.0
+#: the room the two title lines of a box take, mm
+TITLE_ROOM = 14.0
 
 
 @dataclass
@@ -145,7 +126,7 @@ def compose_kinetostatics(mech, position: int, paper: str = "A1", title: TitleIn
     InputError
         A slide input; no ``[loads]``; no speed; a position outside the table or not assembled.
     """
-    plans, i, notes = _analysis(mech, position, omega)
+    plans, i, notes = analysis(mech, position, omega)
     if not title.scheme:
         title = dataclasses.replace(title, scheme=mech.name)
     drawing, free = blank_sheet(paper, title, "Kinetostatic analysis", 2, 3)
@@ -154,204 +135,27 @@ def compose_kinetostatics(mech, position: int, paper: str = "A1", title: TitleIn
     return sheet
 
 
-# ----------------------------------------------------------------------------------------------
-# the numbers
-# ----------------------------------------------------------------------------------------------
-
-
-def _analysis(mech, position: int, omega: float | None) -> tuple[Plans, int, list[str]]:
-    require_crank_input(mech)
-    if mech.extra.get("loads") is None:
-        raise InputError(f"scheme '{mech.name}' declares no [loads]: add [loads] (gravity = [0, -9.81] and the "
-                         "forces, [[loads.forces]]) to draw its kinetostatics sheet")
-    if omega is None:
-        spec = section_of(mech, "dynamics")
-        omega = None if spec is None else spec.mean_speed
-    if omega is None:
-        raise InputError(f"scheme '{mech.name}' declares no speed: add [dynamics] mean_speed = W (rad/s, signed) "
-                         "or give omega to draw its kinetostatics sheet (the inertia forces and the lever need it)")
-    if not (math.isfinite(omega) and omega != 0):
-        raise InputError(f"omega {omega!r}: the kinetostatics sheet needs a moving input, a nonzero finite rad/s")
-    results = forces_results(mech, omega=omega)
-    count = len(results.motion.phi)
-    if not 1 <= position <= count:
-        raise InputError(f"position {position}: scheme '{mech.name}' has the table positions 1 to {count}")
-    failed = [f for f in results.meta["failed"] if f["position"] == position]
-    if failed:
-        raise InputError(f"position {position}: scheme '{mech.name}' {failed[0]['problem']} at the input angle "
-                         f"{failed[0]['input_angle_deg']:.6g} deg: it has no kinetostatics there")
-    return build_plans(results.motion, results.reactions), position - 1, list(results.notes)
-
-
-def _global(motion, link: str, local, i: int) -> np.ndarray:
-    """Global position ``(2,)``, m, of the point ``local`` of ``link`` at position ``i``."""
-    if link == motion.mechanism.frame:
-        return np.asarray(local, float)
-    return motion.poses[link][i, :2] + motion.arm(link, np.asarray(local, float))[i]
-
-
-def _pair_point(motion, pair: str, link: str, i: int) -> np.ndarray:
-    """Where the pair ``pair`` acts on ``link``, m (a prismatic pair: at its slider's point)."""
-    mech = motion.mechanism
-    p = mech.pairs[pair]
-    owner = link if p.point in mech.links[link].points else next(k for k in p.links if p.point in mech.links[k].points)
-    return _global(motion, owner, mech.links[owner].points[p.point], i)
-
-
-def _force_point(plans: Plans, f: PolygonForce, i: int) -> np.ndarray:
-    """Where the polygon force ``f`` acts, m."""
-    motion = plans.motion
-    if f.kind == "reaction":
-        return _pair_point(motion, f.pair, f.link, i)
-    for t in plans.reactions.terms:
-        if t.link == f.link and t.label == f.label:
-            return _global(motion, t.link, t.local, i)
-    raise KeyError(f"no load {f.label} on link {f.link}")
-
-
-def _inner_revolute(mech, polygon: ForcePolygon) -> dict[str, str]:
-    """link -> the revolute pair joining it to the other link of a dyad (empty unless the two
-    links of the group meet in exactly one pair and it is revolute)."""
-    if len(polygon.links) != 2:
-        return {}
-    inner = [n for n, p in mech.pairs.items() if set(p.links) == set(polygon.links)]
-    if len(inner) != 1 or not isinstance(mech.pairs[inner[0]], Revolute):
-        return {}
-    return {k: inner[0] for k in polygon.links}
-
-
-def split_reactions(plans: Plans, polygon: ForcePolygon, i: int) -> list[ReactionSplit]:
-    """The splits ``R = Rⁿ + Rτ`` of the reactions a dyad's polygon finds in its outer revolute
-    pairs: ``Rτ`` from the moment equation of the reaction's link about the inner pair C (every
-    other force and moment on the link), ``Rⁿ`` the projection of the polygon's reaction on BC."""
-    mech = plans.motion.mechanism
-    inner = _inner_revolute(mech, polygon)
-    out = []
-    for f in polygon.forces:
-        if not (f.kind == "reaction" and f.unknown and f.link in inner and isinstance(mech.pairs[f.pair], Revolute)):
-            continue
-        b = _pair_point(plans.motion, f.pair, f.link, i)
-        c = _pair_point(plans.motion, inner[f.link], f.link, i)
-        length = float(np.hypot(*(c - b)))
-        if length <= 1e-9 * mech.size:
-            continue
-        e_n = (c - b) / length
-        e_t = np.array([-e_n[1], e_n[0]])
-        moment = 0.0                                   # about C, of every other force and moment on the link
-        for g in polygon.on_link(f.link):
-            if g.label == f.label or g.pair == inner[f.link]:
-                continue
-            r = _force_point(plans, g, i) - c
-            moment += float(r[0] * g.vector[i, 1] - r[1] * g.vector[i, 0])
-        moment += sum(float(m.value[i]) for m in polygon.moments if m.link == f.link)
-        tangential = (moment / length) * e_t
-        normal = float(f.vector[i] @ e_n) * e_n
-        out.append(ReactionSplit(polygon.step, f.label, f.pair, f.link, inner[f.link], b, c, f.vector[i].copy(),
-                                 normal, tangential))
-    return out
-
-
-# ----------------------------------------------------------------------------------------------
-# names and numbers as written on the sheet
-# ----------------------------------------------------------------------------------------------
-
-_SUB = str.maketrans("0123456789,", "₀₁₂₃₄₅₆₇₈₉‚")
-
-
-def name(label: str, part: str = "") -> str:
-    """A polygon label as written: ``R[2,1]`` -> R₂₁, ``G2`` -> G₂, ``Fi2`` -> Fᵢ₂, ``Mi2`` ->
-    Mᵢ₂; ``part`` ``"n"`` / ``"t"`` gives Rⁿ₂₁ / Rτ₂₁."""
-    top = {"n": "ⁿ", "t": "τ", "": ""}[part]
-    m = re.fullmatch(r"([RM])\[(.+?),(.+?)\](?:\((.+)\))?", label)
-    if m:
-        head, a, b, pair = m.groups()
-        sub = (a + b) if len(a) == len(b) == 1 else f"{a},{b}"
-        return f"{head}{top}{sub.translate(_SUB)}" + (f"({pair})" if pair else "")
-    m = re.fullmatch(r"(G|Fi|Mi|Mb)(\d+)", label)
-    if m:
-        head, link = m.groups()
-        return head[0] + {"i": "ᵢ", "b": "b"}.get(head[1:], "") + link.translate(_SUB)
-    return label
-
-
-def _num(x: float) -> str:
-    """4 significant digits (whole numbers from 10 000 up), a true minus, no -0."""
-    text = f"{x:.0f}" if 1e4 <= abs(x) < 1e9 else f"{x:.4g}"
-    return ("0" if float(text) == 0 else text).replace("-", "−")
-
-
 def _arrow_mm(value: float, largest: float) -> float:
     """The (not to scale) length of a force arrow on a group or the lever, mm."""
     low, high = ARROW_MM
     return low + (high - low) * math.sqrt(value / largest) if largest > 0 else low
 
 
-# ----------------------------------------------------------------------------------------------
-# composing
-# ----------------------------------------------------------------------------------------------
+def _widths(header: list[str], rows: list[list[str]], height: float) -> list[float]:
+    """Column widths (mm) a table's texts fit at ``height`` mm."""
+    columns = zip(header, *rows)
+    return [float(math.ceil(0.7 * WIDTH_MARGIN * height * max(len(t) for t in col) + 2 * CELL_PAD + 2))
+            for col in columns]
 
 
-class _Labels:
-    """Places texts without overlapping the sheet's other texts, inside a box, away from lines."""
-
-    def __init__(self, drawing: Drawing):
-        self.drawing = drawing
-        self.boxes: list[tuple[float, float, float, float]] = []
-        self.marks: list[np.ndarray] = []          # sampled points of the lines drawn
-
-    def taken(self, box) -> None:
-        self.boxes.append(tuple(box))
-
-    def mark(self, points) -> None:
-        pts = np.asarray(points, float).reshape(-1, 2)
-        for a, b in zip(pts[:-1], pts[1:]):
-            n = max(int(np.hypot(*(b - a)) / 1.0), 1)
-            self.marks.append(a + np.linspace(0, 1, n + 1)[:, None] * (b - a))
-        if len(pts) == 1:
-            self.marks.append(pts)
-
-    def add(self, at, text: str, within, height: float = LABEL, prefer=(1.0, 1.0), layer: str = "text",
-            gap: float = 1.2) -> Text | None:
-        """Put ``text`` near ``at`` (mm), inside ``within``; None when no place is free."""
-        marks = np.vstack(self.marks) if self.marks else np.zeros((0, 2))
-        prefer = np.asarray(prefer, float)
-        prefer = prefer / (np.hypot(*prefer) or 1.0)
-        best, best_cost = None, math.inf
-        for ring in (gap, gap + 2.5, gap + 5.0, gap + 8.0, gap + 12.0):
-            for angle in np.radians(np.arange(0, 360, 30)):
-                d = np.array([math.cos(angle), math.sin(angle)])
-                h = ("left" if d[0] > 0.3 else "right" if d[0] < -0.3 else "center")
-                v = ("bottom" if d[1] > 0.3 else "top" if d[1] < -0.3 else "middle")
-                item = Text((float(at[0] + ring * d[0]), float(at[1] + ring * d[1])), text, height=height,
-                            layer=layer, anchor=(h, v))
-                box = item.box()
-                if not _inside(box, within) or any(_overlap(box, b) for b in self.boxes):
-                    continue
-                hits = int(np.sum((marks[:, 0] > box[0]) & (marks[:, 0] < box[2]) & (marks[:, 1] > box[1])
-                                  & (marks[:, 1] < box[3]))) if len(marks) else 0
-                cost = 10.0 * hits + ring + 2.0 * (1.0 - float(d @ prefer))
-                if cost < best_cost:
-                    best, best_cost = item, cost
-            if best is not None and best_cost < ring + 10.0:
-                break
-        if best is None:
-            return None
-        self.boxes.append(best.box())
-        return self.drawing.add(best)
+def _room(box, margin: float) -> tuple[float, float]:
+    """The width and height (mm, at least 1) left in ``box`` under its titles, ``margin`` mm kept all round."""
+    return (max(box[2] - box[0] - 2 * margin, 1.0), max(box[3] - box[1] - 2 * margin - TITLE_ROOM, 1.0))
 
 
-def _inside(box, outer) -> bool:
-    return box[0] >= outer[0] and box[1] >= outer[1] and box[2] <= outer[2] and box[3] <= outer[3]
-
-
-def _overlap(a, b) -> bool:
-    return a[0] < b[2] and b[0] < a[2] and a[1] < b[3] and b[1] < a[3]
-
-
-def _unit(v) -> np.ndarray:
-    v = np.asarray(v, float)
-    n = float(np.hypot(*v))
-    return v / n if n > 0 else np.array([1.0, 0.0])
+def _table_height(rows: int, height: float) -> float:
+    """The height (mm) of a table of one header line and ``rows`` rows at text ``height`` mm."""
+    return (rows + 1) * (2 * height + 1)
 
 
 class _Composer:
@@ -362,43 +166,58 @@ class _Composer:
         self.i = sheet.index
         self.mech = self.plans.motion.mechanism
         self.free = free
-        self.labels = _Labels(self.d)
+        self.labels = Labels(self.d)
         for item in self.d.items:
             if isinstance(item, Text):
                 self.labels.taken(item.box())
-        order = {p.step: p for p in self.plans.polygons}
-        inputs = [p for p in self.plans.polygons if p.step.startswith("I(")]
-        groups = [p for p in self.plans.polygons if not p.step.startswith("I(")]
-        self.rows = list(reversed(groups)) + inputs            # as solved: the farthest group first
-        self.splits = {p.step: split_reactions(self.plans, p, self.i) for p in order.values()}
+        self.inputs = [p for p in self.plans.polygons if p.step.startswith("I(")]
+        self.groups = list(reversed([p for p in self.plans.polygons if not p.step.startswith("I(")]))
+        self.rows = self.groups + self.inputs                  # as solved: the farthest group first
+        self.splits = {p.step: split_reactions(self.plans, p, self.i) for p in self.plans.polygons}
         sheet.splits = [s for p in self.rows for s in self.splits[p.step]]
         self.scene = Geometry(self.plans.motion, [self.i]).scene(self.i)
 
     # -- layout --------------------------------------------------------------------------------
     def compose(self) -> None:
         x0, y0, x1, y1 = self.free
-        width = x1 - x0
-        head_h = 14.0
-        self._heading((x0 + 5, y1 - 4))
-        right_w = min(280.0, 0.34 * width)
-        left = (x0 + 4, y0 + 4, x1 - right_w - 8, y1 - head_h)
-        right = (x1 - right_w - 2, y0 + 4, x1 - 4, y1 - head_h)
-        n = len(self.rows)
-        row_h = (left[3] - left[1]) / n
-        lw = left[2] - left[0]
-        table_w = 76.0
-        cell_w = (lw - table_w - 8) / 2
-        rows = []
-        for k, polygon in enumerate(self.rows):
-            top = left[3] - k * row_h
-            rows.append((polygon, (left[0], top - row_h + 3, left[0] + cell_w, top - 1),
-                         (left[0] + cell_w + 2, top - row_h + 3, left[0] + 2 * cell_w, top - 1),
-                         (left[2] - table_w, top - 1)))
-        self._choose_scales(rows)
-        for polygon, group_box, polygon_box, table_at in rows:
+        self._heading((x0 + 5, y1 - 3))
+        top = y1 - 12
+        right_w = 0.40 * (x1 - x0)
+        left = (x0 + 4, y0 + 4, x1 - right_w - 4, top)
+        right = (x1 - right_w + 4, y0 + 4, x1 - 4, top)
+        # the polygons' tables along the bottom of the left column
+        height, tables = self._polygon_tables_plan(left[2] - left[0])
+        band_top = left[1] + 6 + max(_table_height(len(rows), height) for _, rows, _ in tables)
+        # the groups' rows above them: the group apart and its polygon beside it
+        # the input links on the right, each with its polygon
+        lever_table = self._lever_rows()
+        lever_h_t = self._fitting_height(*lever_table[:2], TITLE_BLOCK_SIZE[0])
+        lever_table_at = (x1 - TITLE_BLOCK_SIZE[0], y0 + TITLE_BLOCK_SIZE[1] + 6)
+        band_c = lever_table_at[1] + _table_height(len(lever_table[1]), lever_h_t) + 2
+        # the groups above the tables: each beside its polygon, or a lone group above its polygon when
+        # that draws it larger (a long group); the input links' band as low as draws them as large
+        area = (left[0], band_top + 2, left[2], top)
+        layouts = [self._beside(area, share) for share in GROUP_SHARE]
+        if len(self.groups) == 1:
+            layouts.insert(0, self._stacked(area))
+        column_h = top - right[1]
+        candidates = [(groups + self._inputs(right, fraction * column_h, share), fraction * column_h)
+                      for fraction in INPUT_BAND for share in INPUT_SHARE for groups in layouts]
+
+        def drawn(candidate) -> tuple:                  # the lever not small, then μ_l and μ_F largest
+            lever = (right[0], band_c + 4, right[2], top - candidate[1] - 2)
+            return (self._lever_longest() / self._lever_scale(lever) < LEVER_MM, *self._scales(candidate[0]))
+
+        boxes, input_h = min(candidates, key=drawn)
+        self._choose_scales(boxes)
+        for polygon, group_box, polygon_box in boxes:
             self._group(polygon, group_box)
-            self._polygon(polygon, polygon_box, table_at)
-        self._right(right)
+            self._polygon(polygon, polygon_box)
+        self._polygon_tables(left, height, tables)
+        lever_box = (right[0], band_c + 4, right[2], top - input_h - 2)
+        self._lever(lever_box)
+        self._lever_table(lever_table, lever_table_at, lever_h_t)
+        self._checks((right[0], band_c, x1 - TITLE_BLOCK_SIZE[0] - 5, y0 + 2))
 
     def _heading(self, at) -> None:
         motion = self.plans.motion
@@ -406,35 +225,71 @@ class _Composer:
         phi = (math.degrees(float(motion.phi[self.i])) + 180.0) % 360.0 - 180.0
         omega = float(motion.omega[self.i])
         text = (f"Kinetostatic analysis of '{self.mech.name}' at position {self.i + 1} of {len(motion.phi) - 1} "
-                f"(turned {_num(turned)}° from position 1, input angle {_num(phi)}°, ω₁ = {_num(omega)} rad/s, ε₁ = {_num(float(motion.eps[self.i]))} rad/s²)")
+                f"(turned {num(turned)}° from position 1, input angle {num(phi)}°, ω₁ = {num(omega)} rad/s, "
+                f"ε₁ = {num(float(motion.eps[self.i]))} rad/s²)")
         self.d.add(Text(at, text, height=HEADING, anchor=("left", "top")))
         self.labels.taken(self.d.items[-1].box())
 
-    def _choose_scales(self, rows) -> None:
+    def _title(self, box, title: str, subtitle: str) -> None:
+        for at, text, h in (((box[0] + 2, box[3] - 1), title, TITLE), ((box[0] + 2, box[3] - 2.5 - TITLE), subtitle,
+                                                                          SUBTITLE)):
+            item = self.d.add(Text(at, text, height=h, anchor=("left", "top")))
+            self.labels.taken(item.box())
+
+    def _inputs(self, right, height: float, share: float) -> list:
+        """(input link, its box, its polygon's box) of each input link: side by side in a band of
+        ``height`` mm at the top of the right column, the link taking ``share`` of its width."""
+        x0, _, x1, top = right
+        mid, step = x0 + share * (x1 - x0), height / len(self.inputs)
+        return [(polygon, (x0, top - (k + 1) * step + 4, mid - 3, top - k * step),
+                 (mid + 3, top - (k + 1) * step + 4, x1, top - k * step)) for k, polygon in enumerate(self.inputs)]
+
+    def _beside(self, area, share: float) -> list:
+        """(group, group box, polygon box) of each group, one row each, the polygon right of the group;
+        the groups take ``share`` of the width."""
+        x0, y0, x1, y1 = area
+        row_h = (y1 - y0) / max(len(self.groups), 1)
+        split_x = x0 + share * (x1 - x0)
+        return [(polygon, (x0, y1 - (k + 1) * row_h + 4, split_x - 3, y1 - k * row_h),
+                 (split_x + 3, y1 - (k + 1) * row_h + 4, x1, y1 - k * row_h)) for k, polygon in enumerate(self.groups)]
+
+    def _stacked(self, area) -> list:
+        """(group, group box, polygon box) of a lone group: the group above, its polygon below."""
+        x0, y0, x1, y1 = area
+        split_y = (y0 + y1) / 2
+        return [(self.groups[0], (x0, split_y + 3, x1, y1), (x0, y0, x1, split_y - 3))]
+
+    def _scales(self, boxes) -> tuple[float, float]:
+        """(μ_l, μ_F): the largest standard drawings at which every group (and input link) fits its box
+        with room for its arrows, the largest at most GROUP_MM, and every polygon fits its box, the
+        longest vector at most 200 mm."""
         i = self.i
-        # μ_l: the largest group (or input link) fits its cell with room for the arrows
         need = 0.0
-        for polygon, box, _, _ in rows:
-            pts = self._link_points(polygon.links)
-            span = np.ptp(pts, axis=0)
-            room = (box[2] - box[0] - 2 * GROUP_MARGIN, box[3] - box[1] - 2 * GROUP_MARGIN - 8)
-            need = max(need, span[0] / room[0], span[1] / room[1])
-        self.mu_l = nice_scale(need)
-        # μ_F: one for every polygon, the largest polygon's longest vector 60..120 mm, every polygon in its cell
+        for polygon, box, _ in boxes:
+            span = np.ptp(self._link_points(polygon.links), axis=0)
+            room = _room(box, GROUP_MARGIN)
+            need = max(need, span[0] / room[0], span[1] / room[1], max(span) / GROUP_MM)
+        mu_l = nice_scale(need)
         longest = max(float(np.hypot(*v.vector[i])) for p in self.plans.polygons for v in p.forces)
-        mu_f = standard_scale(longest, 60.0, 120.0)
-        for polygon, _, box, _ in rows:
+        need = longest / POLYGON_MM[1]
+        for polygon, _, box in boxes:
             span = np.ptp(self._chain(polygon), axis=0)
-            room = (box[2] - box[0] - 24, box[3] - box[1] - 24)
-            mu_f = max(mu_f, nice_scale(max(span[0] / room[0], span[1] / room[1])))
-        self.mu_f = mu_f
-        if longest / mu_f < 60.0:
+            room = _room(box, POLYGON_MARGIN)
+            need = max(need, span[0] / room[0], span[1] / room[1])
+        return mu_l, nice_scale(need)
+
+    def _choose_scales(self, boxes) -> None:
+        i = self.i
+        self.mu_l, self.mu_f = self._scales(boxes)
+        mu_f = self.mu_f
+        longest = max(float(np.hypot(*v.vector[i])) for p in self.plans.polygons for v in p.forces)
+        if longest / mu_f < POLYGON_MM[0]:
             self.sheet.notes.append(f"μ_F is chosen so the polygons fit their places: the longest vector is "
                                     f"{longest / mu_f:.0f} mm")
         for polygon in self.plans.polygons:
             top = max(float(np.hypot(*v.vector[i])) for v in polygon.forces)
             if top / mu_f < TINY_MM:
-                self.sheet.notes.append(f"the polygon of {polygon.step} is small at μ_F = {_num(mu_f)} N/mm (its "
+                self.sheet.notes.append(f"the polygon of {polygon.step} is small at μ_F = {num(mu_f)} N/mm (its "
                                         f"longest vector {top / mu_f:.1f} mm): its table gives the values")
         self.sheet.mu_l, self.sheet.mu_f = self.mu_l, self.mu_f
         self.d.use(Scale("μ_l", self.mu_l, "m/mm"))
@@ -442,25 +297,48 @@ class _Composer:
 
     def _link_points(self, links) -> np.ndarray:
         mech, motion = self.mech, self.plans.motion
-        pts = [_global(motion, k, local, self.i) for k in links for local in mech.links[k].points.values()]
+        pts = [global_point(motion, k, local, self.i) for k in links for local in mech.links[k].points.values()]
         return np.array(pts).reshape(-1, 2)
 
     # -- a group drawn apart ---------------------------------------------------------------------
+    def _shown_forces(self, polygon: ForcePolygon) -> list[tuple[np.ndarray, np.ndarray, str]]:
+        """(point m, vector N, label) of the forces drawn on a group: loads and known reactions as
+        they are, the unknown reactions split or whole."""
+        splits = {s.label: s for s in self.splits[polygon.step]}
+        shown = []
+        for f in polygon.forces:
+            at = force_point(self.plans, f, self.i)
+            if f.label in splits:
+                s = splits[f.label]
+                shown += [(at, s.normal, name(f.label, "n")), (at, s.tangential, name(f.label, "t"))]
+            else:
+                shown.append((at, f.vector[self.i], name(f.label)))
+        return shown
+
     def _group(self, polygon: ForcePolygon, box) -> None:
         d, i = self.d, self.i
-        kind = "input link" if polygon.step.startswith("I(") else "group"
-        links = ", ".join(polygon.links)
-        title = Text((box[0] + 2, box[3] - 1), f"{'Input link' if kind == 'input link' else 'Group'} "
-                     f"{polygon.step}: link{'s' if len(polygon.links) > 1 else ''} {links}, μ_l = {_num(self.mu_l)} m/mm",
-                     height=LABEL, anchor=("left", "top"))
-        d.add(title)
-        self.labels.taken(title.box())
-        d.region(f"group {polygon.step}", box)
         pts = self._link_points(polygon.links)
         centre_q = (pts.min(axis=0) + pts.max(axis=0)) / 2
-        centre_mm = ((box[0] + box[2]) / 2, (box[1] + box[3]) / 2 - 4)
+        centre_mm = ((box[0] + box[2]) / 2, (box[1] + box[3] - TITLE_ROOM) / 2)
         view = d.view(Scale("μ_l", self.mu_l, "m/mm"), origin=centre_mm, at=tuple(centre_q)).paper
+        shown = self._shown_forces(polygon)
+        largest = max([float(np.hypot(*v)) for _, v, _ in shown] + [0.0])
+        shown = [(np.array(view(at)), v, label) for at, v, label in shown if float(np.hypot(*v)) > 1e-9 * largest]
+        links_mm = np.array([view(q) for q in pts])
+        inner = (box[0] + 6, box[1] + 6, box[2] - 6, box[3] - TITLE_ROOM - 6)
+        arrows = self._group_arrows(shown, links_mm, largest, True)
+        to_scale = all(inner[0] <= e[0] <= inner[2] and inner[1] <= e[1] <= inner[3]
+                       for start, end, *_ in arrows for e in (start, end))
+        if not to_scale:
+            arrows = self._group_arrows(shown, links_mm, largest, False)
+        input_link = polygon.step.startswith("I(")
+        self._title(box, f"{'Input link' if input_link else 'Group'} {polygon.step}: "
+                    f"link{'s' if len(polygon.links) > 1 else ''} {', '.join(polygon.links)}",
+                    f"μ_l = {num(self.mu_l)} m/mm; " + (f"forces at μ_F = {num(self.mu_f)} N/mm" if to_scale else
+                                                        "forces not to scale (lines and senses only)"))
+        d.region(f"group {polygon.step}", box)
         inside = set(polygon.links)
+        pins = []
         sc = self.scene
         for link, hull in sc.bodies:
             if link in inside:
@@ -471,55 +349,61 @@ class _Composer:
             if link in inside:
                 a, b = view(line[0]), view(line[1])
                 d.add(Line((a, b), layer="links", width=0.5, dashed=True))
+                self.labels.mark([a, b])
         for link, centre, angle, _ in sc.blocks:
             if link in inside:
                 self._block(view(centre), angle)
         for pair in self.mech.pairs.values():
             if isinstance(pair, Revolute) and set(pair.links) & inside:
-                p = view(_pair_point(self.plans.motion, pair.name, next(k for k in pair.links if k in inside), i))
-                d.add(Circle(p, 1.5, layer="links", width=0.5))
+                p = view(pair_point(self.plans.motion, pair.name, next(k for k in pair.links if k in inside), i))
+                d.add(Circle(p, 1.8, layer="links", width=0.5))
                 self.labels.mark([p])
-                self.labels.add(p, pair.point, box, height=SMALL, prefer=(-1, 1), gap=2.0)
+                pins.append((p, pair.point))
             elif isinstance(pair, Prismatic) and set(pair.links) & inside and not set(pair.links) <= inside:
-                guide_link = pair.links[0]
-                if guide_link not in inside:          # the removed guide: its line through the slider
-                    centre = _pair_point(self.plans.motion, pair.name, pair.links[1], i)
+                if pair.links[0] not in inside:          # the removed guide: its line through the slider
+                    centre = pair_point(self.plans.motion, pair.name, pair.links[1], i)
                     u = self._guide_direction(pair)
-                    a, b = view(centre - 14 * self.mu_l * u), view(centre + 14 * self.mu_l * u)
+                    a, b = view(centre - 18 * self.mu_l * u), view(centre + 18 * self.mu_l * u)
                     d.add(Line((a, b), layer="links", width=0.35, dashed=True))
-        # the forces: loads and known reactions as they are, the unknown reactions split or whole
-        splits = {s.label: s for s in self.splits[polygon.step]}
-        shown: list[tuple[np.ndarray, np.ndarray, str]] = []
-        for f in polygon.forces:
-            at = _force_point(self.plans, f, i)
-            if f.label in splits:
-                s = splits[f.label]
-                shown.append((at, s.normal, name(f.label, "n")))
-                shown.append((at, s.tangential, name(f.label, "t")))
-            else:
-                shown.append((at, f.vector[i], name(f.label)))
-        largest = max([float(np.hypot(*v)) for _, v, _ in shown] + [0.0])
+                    self.labels.mark([a, b])
+        for start, end, _, _ in arrows:
+            d.add(Arrow(tuple(map(float, start)), tuple(map(float, end)), layer="forces", width=0.5, head=3.5))
+            self.labels.mark([start, end])
+        moments = [(np.array(view(self._moment_point(m))), float(m.value[i]), name(m.label)) for m in polygon.moments
+                   if float(m.value[i]) != 0 and np.isfinite(float(m.value[i]))]
+        for centre, value, _ in moments:
+            self._curved(centre, value)
+        for p, label in pins:                           # the labels once every line is drawn
+            self.labels.add(p, label, box, height=LABEL, prefer=(-1, 1), gap=2.5)
+        for start, end, far, label in arrows:
+            self.labels.add(far, label, box, height=LABEL, prefer=far - (start + end) / 2)
+        for centre, value, label in moments:
+            self.labels.add(centre, f"{label} = {num(value)} N·m", box, height=LABEL, prefer=(0.3, -1),
+                            gap=MOMENT_RADIUS + 2.0)
+
+    def _group_arrows(self, shown, links_mm: np.ndarray, largest: float, to_scale: bool) -> list:
+        """(start, end, the end away from the point, label) of each force on a group, mm: from its
+        point, at μ_F or not to scale; a force that would run along a link from its point is drawn
+        ending at the point instead, so the link does not hide it."""
+        out = []
         for at, vector, label in shown:
             size = float(np.hypot(*vector))
-            if size <= 1e-9 * largest:
-                continue
-            start = np.array(view(at))
-            end = start + _arrow_mm(size, largest) * _unit(vector)
-            d.add(Arrow(tuple(start), tuple(end), layer="forces", width=0.5, head=3.0))
-            self.labels.mark([start, end])
-            self.labels.add(end, label, box, height=LABEL, prefer=_unit(vector))
-        for m in polygon.moments:
-            value = float(m.value[i])
-            if value == 0 or not np.isfinite(value):
-                continue
-            at = self._moment_point(m)
-            self._curved(np.array(view(at)), value, f"{name(m.label)} = {_num(value)} N·m", box)
+            u = unit(vector)
+            length = size / self.mu_f if to_scale else _arrow_mm(size, largest)
+            towards = links_mm - at
+            reach = np.hypot(towards[:, 0], towards[:, 1])
+            along = (reach > 1.0) & (towards @ u > np.cos(np.radians(ALONG_DEG)) * reach)
+            if along.any():
+                out.append((at - length * u, at, at - length * u, label))
+            else:
+                out.append((at, at + length * u, at + length * u, label))
+        return out
 
     def _moment_point(self, m) -> np.ndarray:
         mech, i = self.mech, self.i
         if m.pair is not None:
-            return _pair_point(self.plans.motion, m.pair, m.link, i)
-        return _global(self.plans.motion, m.link, mech.links[m.link].center_of_mass, i)
+            return pair_point(self.plans.motion, m.pair, m.link, i)
+        return global_point(self.plans.motion, m.link, mech.links[m.link].center_of_mass, i)
 
     def _guide_direction(self, pair) -> np.ndarray:
         glink = pair.links[0]
@@ -531,21 +415,19 @@ class _Composer:
         c = np.asarray(c)
         u = np.array([math.cos(angle), math.sin(angle)])
         n = np.array([-u[1], u[0]])
-        corners = [c + sx * 6.0 * u + sy * 3.5 * n for sx, sy in ((-1, -1), (1, -1), (1, 1), (-1, 1))]
+        corners = [c + sx * 8.0 * u + sy * 4.5 * n for sx, sy in ((-1, -1), (1, -1), (1, 1), (-1, 1))]
         self.d.add(Line(tuple(tuple(map(float, p)) for p in corners), layer="links", width=0.7, closed=True))
         self.labels.mark(corners + corners[:1])
 
-    def _curved(self, centre: np.ndarray, value: float, label: str, box) -> None:
+    def _curved(self, centre: np.ndarray, value: float) -> None:
         """A moment: an arc of 240° about ``centre`` (mm), CCW for a positive ``value``, its head at
-        the arc's end, and its label."""
-        r = 6.0
+        the arc's end."""
         sense = 1.0 if value > 0 else -1.0
-        angles = np.radians(np.linspace(-30, 210, 25)) if sense > 0 else np.radians(np.linspace(210, -30, 25))
-        pts = centre + r * np.column_stack([np.cos(angles), np.sin(angles)])
+        angles = np.radians(np.linspace(-30, 210, 31)) if sense > 0 else np.radians(np.linspace(210, -30, 31))
+        pts = centre + MOMENT_RADIUS * np.column_stack([np.cos(angles), np.sin(angles)])
         self.d.add(Line(tuple(tuple(map(float, p)) for p in pts[:-1]), layer="forces", width=0.5))
-        self.d.add(Arrow(tuple(map(float, pts[-3])), tuple(map(float, pts[-1])), layer="forces", width=0.5, head=2.5))
+        self.d.add(Arrow(tuple(map(float, pts[-4])), tuple(map(float, pts[-1])), layer="forces", width=0.5, head=3.0))
         self.labels.mark(pts)
-        self.labels.add(centre + np.array([0.0, -r]), label, box, height=SMALL, prefer=(0.3, -1), gap=1.5)
 
     # -- a force polygon -------------------------------------------------------------------------
     def _sequence(self, polygon: ForcePolygon) -> list[tuple[str, str, np.ndarray]]:
@@ -578,62 +460,70 @@ class _Composer:
         seq = self._sequence(polygon)
         return np.vstack([np.zeros(2)] + list(np.cumsum([v for _, _, v in seq], axis=0)))
 
-    def _polygon(self, polygon: ForcePolygon, box, table_at) -> None:
+    def _polygon_vectors(self, polygon: ForcePolygon) -> list[tuple[str, str, np.ndarray]]:
+        """(label, kind, vector N) of every vector a polygon draws: the head-to-tail sequence, then
+        the whole split reactions and the reaction between a dyad's links."""
+        out = list(self._sequence(polygon))
+        out += [(s.label, "resultant", s.whole) for s in self.splits[polygon.step]]
+        if len(polygon.links) == 2 and len(polygon.internal) == 1:
+            out.append((polygon.internal[0].label, "internal", polygon.internal[0].vector[self.i]))
+        return out
+
+    def _polygon_rows(self, polygon: ForcePolygon, mu: float) -> list[list[str]]:
+        rows = []
+        for label, kind, vector in self._polygon_vectors(polygon):
+            size = float(np.hypot(*vector))
+            rows.append([name(label, {"normal": "n", "tangential": "t"}.get(kind, "")), f"{size / mu:.1f}", num(size)])
+        return rows + [[f"{name(m.label)}, N·m", "—", num(float(m.value[self.i]))] for m in polygon.moments]
+
+    def _polygon(self, polygon: ForcePolygon, box) -> None:
         d, i, mu = self.d, self.i, self.mu_f
-        title = Text((box[0] + 2, box[3] - 1), f"Force polygon of {polygon.step}, μ_F = {_num(mu)} N/mm", height=LABEL,
-                     anchor=("left", "top"))
-        d.add(title)
-        self.labels.taken(title.box())
+        self._title(box, f"Force polygon of {polygon.step}", f"μ_F = {num(mu)} N/mm")
         d.region(f"polygon {polygon.step}", box)
         seq = self._sequence(polygon)
         chain = self._chain(polygon) / mu
         lo, hi = chain.min(axis=0), chain.max(axis=0)
-        origin = np.array([(box[0] + box[2]) / 2, (box[1] + box[3]) / 2 - 4]) - (lo + hi) / 2
+        origin = np.array([(box[0] + box[2]) / 2, (box[1] + box[3] - TITLE_ROOM) / 2]) - (lo + hi) / 2
         centroid = origin + chain.mean(axis=0)
         ends: dict[str, tuple[np.ndarray, np.ndarray]] = {}
         here = origin.copy()
         first_link_end = None
-        rows = []
-        for (label, kind, vector), _ in zip(seq, range(len(seq))):
+        texts = []
+        for label, kind, vector in seq:
             start, end = here, here + vector / mu
             here = end
             ends[f"{kind}:{label}"] = (start, end)
-            if kind == "force" or kind in ("normal", "tangential"):
-                pass
             part = {"normal": "n", "tangential": "t"}.get(kind, "")
-            self._vector(polygon.step, label, kind, start, end, vector, name(label, part), box, centroid,
-                         width=0.6 if kind == "force" else 0.45)
-            rows.append([name(label, part), f"{float(np.hypot(*vector)) / mu:.1f}", _num(float(np.hypot(*vector)))])
+            texts.append(self._vector(polygon.step, label, kind, start, end, vector, name(label, part),
+                                      width=0.6 if kind == "force" else 0.45))
             f = next((f for f in polygon.forces if f.label == label), None)
             if f is not None and len(polygon.links) == 2 and f.link == polygon.links[0] and kind != "normal" \
                     and (kind != "force" or not f.unknown):
                 first_link_end = end
         for s in self.splits[polygon.step]:            # the whole reaction: Rⁿ + Rτ
-            n_start = ends[f"normal:{s.label}"][0]
+            n_start, n_end = ends[f"normal:{s.label}"]
             t_start, t_end = ends[f"tangential:{s.label}"]
-            n_end = ends[f"normal:{s.label}"][1]
             start, end = (n_start, t_end) if np.allclose(n_end, t_start) else (t_start, n_end)
-            self._vector(polygon.step, s.label, "resultant", start, end, s.whole, name(s.label), box, centroid,
-                         width=0.35)
-            rows.append([name(s.label), f"{float(np.hypot(*s.whole)) / mu:.1f}", _num(float(np.hypot(*s.whole)))])
+            texts.append(self._vector(polygon.step, s.label, "resultant", start, end, s.whole, name(s.label),
+                                      width=0.35))
         if len(polygon.links) == 2 and len(polygon.internal) == 1 and first_link_end is not None:
             inner = polygon.internal[0]
-            start = first_link_end
-            self._vector(polygon.step, inner.label, "internal", start, start + inner.vector[i] / mu,
-                         inner.vector[i], name(inner.label), box, centroid, width=0.35)
-            rows.append([name(inner.label), f"{float(np.hypot(*inner.vector[i])) / mu:.1f}",
-                         _num(float(np.hypot(*inner.vector[i])))])
-        d.add(Circle(tuple(map(float, origin)), 0.8, layer="forces", filled=True))
-        moments = [[f"{name(m.label)}, N·m", "—", _num(float(m.value[i]))] for m in polygon.moments]
-        table(d, table_at, ["force", "length, mm", "value, N"], rows + moments, [26.0, 22.0, 28.0], height=SMALL,
-              name=f"table {polygon.step}")
+            texts.append(self._vector(polygon.step, inner.label, "internal", first_link_end,
+                                      first_link_end + inner.vector[i] / mu, inner.vector[i], name(inner.label),
+                                      width=0.35))
+        d.add(Circle(tuple(map(float, origin)), 1.0, layer="forces", filled=True))
+        self.labels.mark([origin])
+        for mid, text in texts:                         # the labels once every line is drawn
+            if mid is not None:
+                self.labels.add(mid, text, box, height=LABEL, prefer=mid - centroid, gap=1.2)
 
-    def _vector(self, step, label, kind, start, end, value, text, box, centroid, width) -> None:
+    def _vector(self, step, label, kind, start, end, value, text, width) -> tuple[np.ndarray | None, str]:
+        """Draw a polygon vector; returns its midpoint (None when too short to label) and label."""
         start, end = tuple(map(float, start)), tuple(map(float, end))
         length = math.hypot(end[0] - start[0], end[1] - start[1])
-        head = min(3.0, 0.4 * length + 0.5)
+        head = min(3.5, 0.4 * length + 0.5)
         if kind in ("resultant", "internal"):          # dashed: the shaft, then the head alone
-            u = _unit(np.subtract(end, start))
+            u = unit(np.subtract(end, start))
             items = (self.d.add(Line((start, end), layer="forces", width=width, dashed=True)),
                      self.d.add(Arrow(tuple(map(float, np.asarray(end) - min(head, length) * u)), end,
                                       layer="forces", width=width, head=head)))
@@ -641,38 +531,124 @@ class _Composer:
             items = (self.d.add(Arrow(start, end, layer="forces", width=width, head=head)),)
         self.sheet.vectors.append(DrawnVector(step, label, kind, start, end, np.asarray(value, float).copy(), items))
         self.labels.mark([start, end])
-        if length >= LABELLED_MM:
-            mid = (np.asarray(start) + np.asarray(end)) / 2
-            self.labels.add(mid, text, box, height=SMALL, prefer=mid - centroid, gap=1.0)
+        return ((np.asarray(start) + np.asarray(end)) / 2 if length >= LABELLED_MM else None), text
 
-    # -- the right column: lever, tables, scales, notes ------------------------------------------
-    def _right(self, box) -> None:
-        d, i = self.d, self.i
-        plans = self.plans
+    # -- the tables ------------------------------------------------------------------------------
+    def _polygon_tables_plan(self, width: float) -> tuple[float, list]:
+        """The text height the polygons' tables fit ``width`` mm side by side at, and each table's
+        (header, rows, widths); rows sized with lengths at 1 N/mm (the widest they can be)."""
+        header = ["force", "length, mm", "value, N"]
+        for height in TABLE_HEIGHTS:
+            tables = []
+            for polygon in self.rows:
+                rows = self._polygon_rows(polygon, 1.0)
+                tables.append((header, rows, _widths(header, rows, height)))
+            if sum(sum(w) for *_, w in tables) + 8 * (len(tables) - 1) <= width or height == TABLE_HEIGHTS[-1]:
+                return height, tables
+        raise AssertionError("unreachable")
+
+    def _polygon_tables(self, left, height: float, tables) -> None:
+        x = left[0]
+        gap = (left[2] - left[0] - sum(sum(w) for *_, w in tables)) / max(len(tables), 1)
+        x += gap / 2
+        top = left[1] + 6 + max(_table_height(len(rows), height) for _, rows, _ in tables)
+        for polygon, (header, _, widths) in zip(self.rows, tables):
+            caption = self.d.add(Text((x, top + 1), f"Polygon of {polygon.step}", height=SUBTITLE))
+            self.labels.taken(caption.box())
+            table(self.d, (x, top), header, self._polygon_rows(polygon, self.mu_f), widths, height=height,
+                  name=f"table {polygon.step}")
+            x += sum(widths) + gap
+
+    def _fitting_height(self, header, rows, width: float) -> float:
+        return next((h for h in TABLE_HEIGHTS if sum(_widths(header, rows, h)) <= width), TABLE_HEIGHTS[-1])
+
+    def _lever_rows(self) -> tuple[list[str], list[list[str]]]:
+        """The header and rows of the lever's table (the arm ``h`` at ``μ_v``, filled once it is known)."""
+        lever, i = self.plans.lever, self.i
+        biggest = max([abs(float(f.moment[i])) for f in lever.forces]
+                      + [abs(float(m.contribution[i])) for m in lever.moments] + [1e-300])
+
+        def zeroed(x: float) -> str:                    # round-off of a force through the pole reads 0
+            return num(x if abs(x) > 1e-12 * biggest else 0.0)
+
+        rows = []
+        for f in lever.forces:
+            size = float(np.hypot(*f.force[i]))
+            arm = abs(float(f.moment[i])) / size if size > 0 else 0.0          # m/s; /μ_v gives mm
+            rows.append([f"{name(f.label)} at {image(f.point)}", num(size), arm, zeroed(float(f.moment[i]))])
+        for m in lever.moments:
+            rows.append([f"{name(m.label)}·ω{m.link.translate(SUB)}", num(float(m.value[i])), "—",
+                         zeroed(float(m.contribution[i]))])
+        rows = [[r[0], r[1], "000.0" if isinstance(r[2], float) else r[2], r[3]] for r in rows]
+        return ["force at its image", "F, N", "h, mm", "F·h·μ_v, N·m/s"], rows
+
+    def _lever_table(self, header_rows, bottom_left, height: float) -> None:
+        header, rows = header_rows
+        lever, i = self.plans.lever, self.i
+        for row, f in zip(rows, lever.forces):
+            size = float(np.hypot(*f.force[i]))
+            row[2] = f"{abs(float(f.moment[i])) / size / self.mu_v:.1f}" if size > 0 else "0.0"
+        top = bottom_left[1] + _table_height(len(rows), height)
+        table(self.d, (bottom_left[0], top), header, rows, _widths(header, rows, height), height=height,
+              name="lever table")
+
+    def _checks(self, box) -> None:
+        """``M_b`` by the lever's formula, the table comparing it with the polygons', the scales and
+        the notes, top down in ``box``."""
+        d, i, lever = self.d, self.i, self.plans.lever
+        x0, top, x1, _ = box
+        total = sum(float(f.moment[i]) for f in lever.forces) + sum(float(m.contribution[i]) for m in lever.moments)
+        mb_lever = float(lever.balancing_moment[i])
+        mb_poly = float(next(m.value[i] for m in self.inputs[0].moments if m.kind == "balancing"))
+        self.sheet.mb_lever, self.sheet.mb_polygons = mb_lever, mb_poly
+        formula = d.add(Text((x0, top), f"Mb = −ΣM/ω₁ =\n−({num(total)})/({num(float(lever.omega[i]))}) = "
+                             f"{num(mb_lever)} N·m", height=SUBTITLE, anchor=("left", "top")))
+        self.labels.taken(formula.box())
+        diff = (mb_lever - mb_poly) / abs(mb_poly) * 100.0 if mb_poly != 0 else 0.0
+        header = ["balancing moment Mb", "Mb, N·m", "difference, %"]
+        rows = [["by the force polygons", num(mb_poly), ""],
+                ["by Zhukovsky's lever", num(mb_lever), num(round(diff, 3)) if abs(diff) >= 1e-3 else "0.000"]]
+        height = self._fitting_height(header, rows, x1 - x0)
+        mb = table(d, (x0, formula.box()[1] - 3), header, rows, _widths(header, rows, height), height=height,
+                   name="balancing moment")
+        sc = scales_table(d, (x0, mb[1] - 4), height=height)
+        notes = ["Arrows on the lever show the lines and senses of the forces, not to scale: its table gives "
+                 "the values; the polygons are drawn at μ_F."] + self.sheet.notes
+        text = "\n".join(wrapped(f"{k + 1}. {line}", 0.7 * WIDTH_MARGIN * 3.0, x1 - x0)
+                         for k, line in enumerate(notes))
+        note = d.add(Text((x0, sc[1] - 3), "Notes:\n" + text, height=3.0, anchor=("left", "top")))
+        self.labels.taken(note.box())
+
+    # -- Zhukovsky's lever -----------------------------------------------------------------------
+    def _lever_longest(self) -> float:
+        """The velocity plan's longest vector, m/s."""
+        return max(float(np.hypot(*v.vector[self.i])) for v in self.plans.velocity.vectors)
+
+    def _lever_scale(self, box) -> float:
+        """μ_v, (m/s)/mm: the largest standard drawing the lever fits ``box`` at with room for its arrows."""
+        v = self.plans.velocity.images
+        pts = np.array([np.zeros(2)] + [[q[self.i, 1], -q[self.i, 0]] for q in v.values()])
+        span = np.ptp(pts, axis=0)
+        room = _room(box, GROUP_MARGIN)
+        return nice_scale(max(span[0] / room[0], span[1] / room[1]))
+
+    def _lever(self, box) -> None:
+        d, i, plans = self.d, self.i, self.plans
         lever = plans.lever
         x0, y0, x1, y1 = box
-        lever_box = (x0, y1 - 245, x1, y1)
-        d.region("lever", lever_box)
+        d.region("lever", box)
         turned = {k: np.array([v[i, 1], -v[i, 0]]) for k, v in plans.velocity.images.items()}
         turned[POLE] = np.zeros(2)
-        longest = max(float(np.hypot(*v.vector[i])) for v in plans.velocity.vectors)
         pts = np.array(list(turned.values()))
-        span = np.ptp(pts, axis=0)
-        room = (x1 - x0 - 2 * GROUP_MARGIN, lever_box[3] - lever_box[1] - 2 * GROUP_MARGIN - 8)
-        # μ_v: the finest standard scale the lever fits its place at (its longest vector at least 60 mm)
-        mu_v = nice_scale(max(span[0] / room[0], span[1] / room[1]))
-        if longest / mu_v < 60.0:
-            mu_v = standard_scale(longest, 60.0, 120.0)
-            self.sheet.notes.append(f"the lever is drawn at μ_v = {_num(mu_v)} (m/s)/mm, larger than its place "
-                                    "allows")
-        self.sheet.mu_v = mu_v
-        title = Text((x0 + 2, y1 - 1), f"Zhukovsky's lever: the velocity plan turned 90° clockwise, "
-                     f"μ_v = {_num(mu_v)} (m/s)/mm", height=LABEL, anchor=("left", "top"))
-        d.add(title)
-        self.labels.taken(title.box())
-        d.use(Scale("μ_v", mu_v, "(m/s)/mm"))
+        self.mu_v = self.sheet.mu_v = mu_v = self._lever_scale(box)
+        longest = self._lever_longest()
+        if longest / mu_v < LEVER_MM:
+            self.sheet.notes.append(f"the lever is small at μ_v = {num(mu_v)} (m/s)/mm: its longest vector is "
+                                    f"{longest / mu_v:.0f} mm")
+        self._title(box, "Zhukovsky's lever: the velocity plan turned 90° clockwise",
+                    f"μ_v = {num(mu_v)} (m/s)/mm; the forces at the images of their points, not to scale")
         centre_q = (pts.min(axis=0) + pts.max(axis=0)) / 2
-        view = d.view(Scale("μ_v", mu_v, "(m/s)/mm"), origin=((x0 + x1) / 2, (lever_box[1] + lever_box[3]) / 2 - 4),
+        view = d.view(Scale("μ_v", mu_v, "(m/s)/mm"), origin=((x0 + x1) / 2, (y0 + y1 - TITLE_ROOM) / 2),
                       at=tuple(centre_q)).paper
         frame_points = {q for q in plans.velocity.images if q in self.mech.point_names
                         and self.mech.point_link(q) == self.mech.frame}
@@ -687,82 +663,25 @@ class _Composer:
                 d.add(Line((a, b), layer="plans", width=0.25))
                 self.labels.mark([a, b])
         p = view(turned[POLE])
-        d.add(Circle(p, 0.8, layer="plans", filled=True))
-        self.labels.add(p, "p", lever_box, height=LABEL, prefer=(-1, -1))
-        for label, q in turned.items():
-            if label == POLE or label in frame_points or np.hypot(*q) / mu_v < 0.5:
-                continue
-            at = view(q)
-            d.add(Circle(at, 0.6, layer="plans", filled=True))
-            self.labels.add(at, _image(label), lever_box, height=SMALL, prefer=(1, 1))
+        d.add(Circle(p, 1.0, layer="plans", filled=True))
+        self.labels.mark([p])
         largest = max([float(np.hypot(*f.force[i])) for f in lever.forces] + [0.0])
+        arrows = []
         for f in lever.forces:
             size = float(np.hypot(*f.force[i]))
             if size <= 1e-9 * largest:
                 continue
             start = np.array(view(turned[f.point]))
-            end = start + _arrow_mm(size, largest) * _unit(f.force[i])
-            d.add(Arrow(tuple(start), tuple(end), layer="forces", width=0.5, head=3.0))
+            end = start + _arrow_mm(size, largest) * unit(f.force[i])
+            d.add(Arrow(tuple(start), tuple(end), layer="forces", width=0.5, head=3.5))
             self.labels.mark([start, end])
-            self.labels.add(end, name(f.label), lever_box, height=SMALL, prefer=_unit(f.force[i]))
-        # the lever's table
-        omega = float(lever.omega[i])
-        biggest = max([abs(float(f.moment[i])) for f in lever.forces]
-                      + [abs(float(m.contribution[i])) for m in lever.moments] + [1e-300])
-
-        def zeroed(x: float) -> str:                    # round-off of a force through the pole reads 0
-            return _num(x if abs(x) > 1e-12 * biggest else 0.0)
-
-        rows = []
-        for f in lever.forces:
-            size = float(np.hypot(*f.force[i]))
-            moment = float(f.moment[i])
-            arm = abs(moment) / size / mu_v if size > 0 else 0.0
-            rows.append([f"{name(f.label)} at {_image(f.point)}", _num(size), f"{arm:.1f}", zeroed(moment)])
-        for m in lever.moments:
-            rows.append([f"{name(m.label)}·ω{m.link.translate(_SUB)}", _num(float(m.value[i])),
-                         "—", zeroed(float(m.contribution[i]))])
-        top = lever_box[1] - 3
-        tb = table(d, (x0, top), ["force at its image", "F, N", "h, mm", "F·h·μ_v, N·m/s"], rows,
-                   [44.0, 24.0, 16.0, 34.0], height=SMALL, name="lever table")
-        total = sum(float(f.moment[i]) for f in lever.forces) + sum(float(m.contribution[i]) for m in lever.moments)
-        mb_lever = float(lever.balancing_moment[i])
-        inputs = [p for p in plans.polygons if p.step.startswith("I(")]
-        mb_poly = float(next(m.value[i] for m in inputs[0].moments if m.kind == "balancing"))
-        self.sheet.mb_lever, self.sheet.mb_polygons = mb_lever, mb_poly
-        formula = Text((x0, tb[1] - 2), f"Mb = −ΣM/ω₁ = −({_num(total)})/({_num(omega)}) = {_num(mb_lever)} N·m",
-                       height=SMALL, anchor=("left", "top"))
-        d.add(formula)
-        self.labels.taken(formula.box())
-        diff = (mb_lever - mb_poly) / abs(mb_poly) * 100.0 if mb_poly != 0 else 0.0
-        mb = table(d, (x0, formula.box()[1] - 3), ["balancing moment Mb", "Mb, N·m", "difference, %"],
-                   [["by the force polygons", _num(mb_poly), ""],
-                    ["by Zhukovsky's lever", _num(mb_lever), _num(round(diff, 3)) if abs(diff) >= 1e-3 else "0.000"]],
-                   [50.0, 28.0, 28.0], height=SMALL, name="balancing moment")
-        sc = scales_table(d, (x0, mb[1] - 4), height=SMALL)
-        notes = ["Arrows on the groups and on the lever show the lines and senses of the forces, not to "
-                 "scale: the polygons are drawn at μ_F and their tables give the values."] + self.sheet.notes
-        text = "\n".join(_wrapped(f"{k + 1}. {line}", 0.7 * SMALL, x1 - x0 - (sc[2] - x0) - 6)
-                         for k, line in enumerate(notes))
-        note = Text((sc[2] + 4, sc[3]), "Notes:\n" + text, height=SMALL, anchor=("left", "top"))
-        d.add(note)
-
-
-def _wrapped(text: str, char_mm: float, width_mm: float) -> str:
-    chars = max(int(width_mm / char_mm), 10)
-    lines: list[str] = []
-    for word in text.split():
-        if lines and len(lines[-1]) + 1 + len(word) <= chars:
-            lines[-1] += " " + word
-        else:
-            lines.append(word)
-    return "\n".join(lines)
-
-
-def _image(label: str) -> str:
-    """The image of a point on the lever in lower case: ``B`` -> b, ``S2`` -> s₂, ``A(3)`` -> a₃."""
-    m = re.fullmatch(r"([A-Za-z]+)(\d*)(?:\((.+)\))?('*)", label)
-    if not m:
-        return label.lower()
-    letters, digits, link, primes = m.groups()
-    return letters.lower() + (digits + (link or "")).translate(_SUB) + primes
+            arrows.append((end, name(f.label), unit(f.force[i])))
+        self.labels.add(p, "p", box, height=LABEL, prefer=(-1, -1), gap=1.5)
+        for label, q in turned.items():
+            if label == POLE or label in frame_points or np.hypot(*q) / mu_v < 0.5:
+                continue
+            at = view(q)
+            d.add(Circle(at, 0.8, layer="plans", filled=True))
+            self.labels.add(at, image(label), box, height=LABEL, prefer=(1, 1), gap=1.5)
+        for end, label, direction in arrows:
+            self.labels.add(end, label, box, height=LABEL, prefer=direction)
