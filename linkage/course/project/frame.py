@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import itertools
 import re
+import textwrap
 from dataclasses import dataclass
 
 import numpy as np
@@ -198,12 +199,7 @@ def _cell_text(drawing: Drawing, cell, text: str, heights=TEXT_HEIGHTS, align: s
 def _wrap(text: str, max_chars: float, max_lines: int) -> list[str] | None:
     """``text`` broken at spaces into at most ``max_lines`` lines of at most ``max_chars``
     characters (None when it cannot be)."""
-    lines: list[str] = []
-    for word in text.split():
-        if lines and len(lines[-1]) + 1 + len(word) <= max_chars:
-            lines[-1] += " " + word
-        else:
-            lines.append(word)
+    lines = textwrap.wrap(text, max(1, int(max_chars)), break_long_words=False, break_on_hyphens=False)
     if not lines or len(lines) > max_lines or any(len(line) > max_chars + _TOL for line in lines):
         return None
     return lines

@@ -9,12 +9,19 @@ from __future__ import annotations
 
 import math
 import re
+import textwrap
 from dataclasses import dataclass
 
 import numpy as np
 
 from ...errors import InputError
-from ...kinetostatics.plans import ForcePolygon, Plans, PolygonForce, build_plans, require_crank_input
+from ...kinetostatics.plans import (
+    ForcePolygon,
+    Plans,
+    PolygonForce,
+    build_plans,
+    require_crank_input,
+)
 from ...model.mechanism import Revolute
 from ...model.scheme import section_of
 from ...report.results import forces_results
@@ -271,14 +278,10 @@ def unit(v) -> np.ndarray:
 
 
 def wrapped(text: str, char_mm: float, width_mm: float) -> str:
+    """``text`` broken at spaces into lines of at most ``width_mm`` mm at ``char_mm`` mm a
+    character (10 characters at least; a longer word keeps its line)."""
     chars = max(int(width_mm / char_mm), 10)
-    lines: list[str] = []
-    for word in text.split():
-        if lines and len(lines[-1]) + 1 + len(word) <= chars:
-            lines[-1] += " " + word
-        else:
-            lines.append(word)
-    return "\n".join(lines)
+    return "\n".join(textwrap.wrap(text, chars, break_long_words=False, break_on_hyphens=False))
 
 
 def image(label: str) -> str:
