@@ -43,20 +43,26 @@ def test_custom_mechanism_example_reports_the_lever_stroke(example_run):
 
 @pytest.mark.parametrize("name", list(linkage.shipped_schemes()))
 def test_draw_mechanism_puts_every_pair_where_the_analysis_has_it(name):
-    """A revolute pair is a circle at its point, a prismatic pair the slider's block centred there."""
+    """A revolute pair is a circle at its point, a prismatic pair the slider's block centred there (or,
+    for a hydraulic cylinder, the rod's end there and its piston inside the barrel)."""
     mech = linkage.load(name)
     # a crank at 40 deg; a slide input 40 % into its stroke
     at = np.radians([40.0]) if mech.coordinate.is_angle else [np.dot([0.6, 0.4], mech.input_range)]
     motion = linkage.analyze(mech, at)
     ax = draw_mechanism(motion, 0)
-    artists = {p.get_gid(): p for p in ax.patches if p.get_gid()}
+    artists = {p.get_gid(): p for p in [*ax.patches, *ax.lines] if p.get_gid()}
     for pair in mech.pairs.values():
         expected = motion.point(pair.point)[0]
         if pair.kind == "R":
             centre = np.asarray(artists[f"pair:{pair.name}"].center)
-        else:
-            block = artists[f"block:{pair.links[1]}"]
-            centre = block.get_xy()[:4].mean(axis=0)
+        elif f"block:{pair.links[1]}" in artists:
+            centre = artists[f"block:{pair.links[1]}"].get_xy()[:4].mean(axis=0)
+        else:   # a hydraulic cylinder: the rod's outer end at the pair's point, its piston in the barrel
+            rod = np.column_stack(artists[f"rod:{pair.links[1]}"].get_data())
+            centre = rod[np.argmin(np.hypot(*(rod - expected).T))]
+            barrel = artists[f"barrel:{pair.links[0]}"].get_path()
+            piston = np.column_stack(artists[f"piston:{pair.links[1]}"].get_data()).mean(axis=0)
+            assert barrel.contains_point(piston), pair.name
         assert np.hypot(*(centre - expected)) < 1e-12 * mech.size, pair.name
     matplotlib.pyplot.close(ax.figure)
 

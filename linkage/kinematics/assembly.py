@@ -31,7 +31,7 @@ from ..errors import SchemeError
 from ..model.mechanism import Mechanism
 from ..structure import Structure, structure_of
 from .inputs import input_poses
-from .tracing import finite_poses, trace_modes, track_of
+from .tracing import finite_poses, same_circuit, trace_modes, track_of
 from .turning import turning_reason
 
 __all__ = ["BranchPlan", "assembly_plans", "assembly_branches", "place_group", "BRANCH_SWEEP"]
@@ -460,7 +460,11 @@ def _chosen_trace(mech, group, rule, traces, poses, phi) -> int:
     if best == 0:
         raise SchemeError(f"{where}: none of its {len(traces)} assembly modes places point '{rule.point}' "
                           f"{_describe(rule)} {at}; check the condition (and its phi_deg)")
-    if len(traces) > 1 and scores[order[1]] == best:
+    tied = [int(n) for n in order if scores[n] == best]
+    if len(tied) > 1 and all(same_circuit(group, traces[tied[0]], traces[n]) for n in tied[1:]):
+        # one mode that runs more than a turn, traced from two angles: either holds the declared pose
+        return max(tied, key=lambda n: int(np.sum(finite_poses(traces[n].rows))))
+    if len(tied) > 1:
         raise SchemeError(
             f"{where}: assembly of point '{rule.point}' ({_describe(rule)}) does not tell its assembly modes "
             f"apart (two of its {len(traces)} modes satisfy it at {best} of {len(phi)} input angles; choose a "

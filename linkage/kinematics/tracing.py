@@ -28,7 +28,7 @@ import numpy as np
 
 from assur.generic import TRACE_JUMP, newton
 
-__all__ = ["Trace", "trace_modes", "track_of", "random_start_modes", "poses_distance", "finite_poses", "STARTS", "SEEDS",
+__all__ = ["Trace", "trace_modes", "track_of", "random_start_modes", "poses_distance", "finite_poses", "same_circuit", "STARTS", "SEEDS",
            "REFINEMENTS", "LIMIT_BISECTIONS"]
 
 TWO_PI = 2 * np.pi
@@ -395,19 +395,17 @@ def _limit(group, last: Poses, angle: float, step: float, known_at, listing: boo
 
 def _stitched(group, traces: list[Trace], size: float) -> list[Trace]:
     """The traces with those of one mode joined: a trace that coincides with an earlier one
-    (within :data:`SAME_MODE` of the size) at every sweep angle where both exist, or at two of
-    them at least, is merged into it (its sweep poses fill the earlier one's gaps, its refined
-    samples are added). Two modes meet at single angles (a change point, hardly ever on the
-    sweep itself); a mode that runs on for more than a turn before it ends at a limit position
-    passes some angles twice: its two traces coincide over the rest of the turn, and the merged
-    trace holds one of its two poses there."""
+    (within :data:`SAME_MODE` of the size) at every sweep angle where both exist, and at one at
+    least, is merged into it (its sweep poses fill the earlier one's gaps, its refined samples are
+    added). A mode that runs on for more than a turn before it ends at a limit position passes
+    some angles twice: its traces coincide over part of the turn and differ where it passes twice,
+    so they stay apart (each holds one of its passes there; :func:`same_circuit` tells them)."""
     kept: list[Trace] = []
     for trace in traces:
         for n, other in enumerate(kept):
             gap = poses_distance(trace.rows, other.rows, group.links, size)
             both = np.isfinite(gap)
-            same = np.sum(gap[both] <= SAME_MODE * size)
-            if both.any() and (same == both.sum() or same >= 2):
+            if both.any() and np.all(gap[both] <= SAME_MODE * size):
                 rows = {k: np.where(np.isfinite(v), v, trace.rows[k]) for k, v in other.rows.items()}
                 kept[n] = Trace(rows, np.concatenate([other.refined_at, trace.refined_at]),
                                 {k: np.concatenate([v, trace.refined[k]]) for k, v in other.refined.items()})
@@ -439,3 +437,12 @@ def poses_distance(a: Poses, b: Poses, links, size: float) -> np.ndarray:
     """Distance between the poses ``(..., 3)`` of several links, m: the root of the sum of
     :func:`_pose_distance` squared over ``links``."""
     return np.sqrt(sum(_pose_distance(a[k], b[k], size) ** 2 for k in links))
+
+
+def same_circuit(group, a: Trace, b: Trace) -> bool:
+    """Whether two traces hold one mode that runs more than a turn: they coincide (within
+    :data:`SAME_MODE` of the size) at two sweep angles at least (two modes meet at single
+    angles, hardly ever on the sweep itself)."""
+    size = float(np.max(group.size))
+    gap = poses_distance(a.rows, b.rows, group.links, size)
+    return int(np.sum(np.nan_to_num(gap, nan=np.inf) <= SAME_MODE * size)) >= 2

@@ -1,7 +1,7 @@
 """The kinetostatics sheet of a course project: each Assur group drawn apart with its loads and
 reactions, the force polygons, Zhukovsky's lever and the check of the balancing moment.
 
-The A1 layout is the course's (METHOD §10). On the left, one row per Assur group in the order
+The A1 layout is the course's (docs/sheets.md). On the left, one row per Assur group in the order
 they are solved (from the farthest): the group drawn apart at the sheet's ``μ_l`` with its applied
 forces, gravity, inertia forces, inertia and applied moments (curved arrows with their values) and
 the reactions of its outer pairs, and its force polygon beside it at the sheet's one ``μ_F``;
