@@ -78,7 +78,7 @@ def plot_resistance(motion):
     pyplot()
     phi = np.asarray(motion.phi, float)
     steps = max(2, int(np.ceil(abs(phi[-1] - phi[0]) / np.radians(1.0))) + 1)
-    sweep = analyze(motion.mechanism, np.linspace(phi[0], phi[-1], steps), order=0, on_failure="mask")
+    sweep = analyze(motion.mechanism, np.linspace(phi[0], phi[-1], steps), order=2, on_failure="mask")
     lines = [(along, float(np.nanmin(position @ along))) for _, along, position, _ in _lines(sweep)]
     dense = resistance_curves(sweep, lines)
     curves = resistance_curves(motion, lines)
