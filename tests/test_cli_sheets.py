@@ -82,3 +82,20 @@ def test_every_shipped_scheme_gets_its_sheets_without_a_layout_problem(name):
         assert layout_problems(drawing) == [], (name, sheet)
     for note in notes:      # a sheet left out names what to add
         assert "left out" in note and ("add" in note or "driven by a slide" in note), note
+
+
+@pytest.mark.parametrize("missing, formats, words", [
+    ("matplotlib", "pdf", "needs the 'report' extra (matplotlib missing)"),
+    ("ezdxf", "pdf,dxf", "needs ezdxf"),
+])
+def test_a_missing_extra_is_named_with_what_to_install(monkeypatch, capsys, tmp_path, missing, formats, words):
+    import importlib.util
+
+    from linkage.cli import main
+
+    real = importlib.util.find_spec
+    monkeypatch.setattr(importlib.util, "find_spec", lambda name, *a: None if name == missing else real(name, *a))
+    assert main(["sheets", "four_bar", "--out", str(tmp_path / "s"), "--format", formats]) == 2
+    err = capsys.readouterr().err
+    assert words in err and 'pip install "linkage[report]"' in err and "Traceback" not in err
+    assert not (tmp_path / "s").exists()

@@ -4,10 +4,12 @@ to scale, as PDF, DXF and SVG."""
 from __future__ import annotations
 
 import argparse
+import importlib.util
 
 from ..course.project.model import PAPERS
 from ..course.project.sheets import write_project_sheets
 from ..errors import InputError
+from ..report.folder import ReportExtraMissing, require_report_extra
 from ..model.numbers import MAX_POSITIONS
 from .options import (CONVENTIONS, HelpFormatter, add_scheme_argument, add_speed_arguments, input_speed, load_scheme,
                       note, out, whole)
@@ -48,6 +50,10 @@ def run(args: argparse.Namespace) -> int:
     unknown = [f for f in formats if f not in SHEET_FORMATS]
     if unknown or not formats:
         raise InputError(f"--format {args.format!r}: choose among {', '.join(SHEET_FORMATS)} (comma-separated)")
+    require_report_extra("linkage sheets")
+    if "dxf" in formats and importlib.util.find_spec("ezdxf") is None:
+        raise ReportExtraMissing("linkage sheets --format dxf needs ezdxf, in the 'report' extra: "
+                                 "pip install \"linkage[report]\" (or --format pdf,svg)")
     mech = load_scheme(args)
     written, notes = write_project_sheets(mech, args.out, args.position, formats, args.paper,
                                           omega=input_speed(args, mech))
