@@ -99,3 +99,12 @@ def test_a_missing_extra_is_named_with_what_to_install(monkeypatch, capsys, tmp_
     err = capsys.readouterr().err
     assert words in err and 'pip install "linkage[report]"' in err and "Traceback" not in err
     assert not (tmp_path / "s").exists()
+
+
+def test_the_title_block_names_the_student_group_and_variant(linkage_run):
+    run = linkage_run("sheets", "four_bar", "--out", "s", "--format", "svg", "--student", "Ivanov I. I.",
+                      "--group", "MT-21-3", "--variant", "12")
+    assert run.status == 0, run.err
+    text = (run.cwd / "s" / "four_bar_kinematics.svg").read_text(encoding="utf-8")
+    for words in ("Ivanov I. I.", "MT-21-3", "12", "four_bar"):
+        assert words in text

@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 import importlib.util
 
+from ..course.project.frame import TitleInfo
 from ..course.project.model import PAPERS
 from ..course.project.sheets import write_project_sheets
 from ..errors import InputError
@@ -42,6 +43,9 @@ def add(sub) -> None:
     add_speed_arguments(p, "input angular velocity for the kinetostatics sheet (default: the scheme's mean speed)")
     p.add_argument("--paper", choices=tuple(k for k in PAPERS if k != "A4"), default="A1",
                    help="the paper size, landscape (default A1, 841 x 594 mm)")
+    for option, what in (("--student", "the student's name"), ("--group", "the student's group"),
+                         ("--variant", "the assignment's variant")):
+        p.add_argument(option, metavar="TEXT", default="", help=f"{what}, for the title block (default blank)")
     p.set_defaults(handler=run)
 
 
@@ -55,7 +59,8 @@ def run(args: argparse.Namespace) -> int:
         raise ReportExtraMissing("linkage sheets --format dxf needs ezdxf, in the 'report' extra: "
                                  "pip install \"linkage[report]\" (or --format pdf,svg)")
     mech = load_scheme(args)
-    written, notes = write_project_sheets(mech, args.out, args.position, formats, args.paper,
+    title = TitleInfo(scheme=mech.name, variant=args.variant, student=args.student, group=args.group)
+    written, notes = write_project_sheets(mech, args.out, args.position, formats, args.paper, title,
                                           omega=input_speed(args, mech))
     for line in notes:
         note("note", line)
