@@ -27,28 +27,20 @@ their place saying so.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
 
 import numpy as np
 
-from assur.base import OK
-
 from ...errors import InputError
-from ...kinematics.extremes import extreme_positions
-from ...kinematics.motion import Motion, analyze
-from ...kinetostatics.loads import CycleTable, StrokeDiagram, loads_of
-from ...kinetostatics.plans import Plans, build_plans
-from ...model.mechanism import Mechanism, Prismatic, Revolute
-from ...model.scheme import section_of
+from ...kinematics.motion import analyze
+from ...model.mechanism import Mechanism, Prismatic
 from ...report.animation import default_trajectories
 from ...report.drawing import Geometry
-from ...report.results import TableResults, analog_direction, kinematics_results
+from ...report.results import analog_direction
 from ...structure import mobility, structure_of
 from .frame import WIDTH_MARGIN, TitleInfo, blank_sheet, scales_table, table
+from .kinematics_data import KinematicsData, kinematics_data
 from .kinematics_parts import (
     SUBSCRIPT,
-    leader,
-    number_along_path,
     LabelPlacer,
     Sketch,
     draw_diagram,
@@ -56,103 +48,25 @@ from .kinematics_parts import (
     draw_scene,
     drawn_vectors,
     fitting_scale,
+    leader,
+    number_along_path,
     plan_extent,
     scene_points,
     vector_name,
 )
-from .model import Arrow, Drawing, Line, Scale, Text, standard_scale
+from .kinematics_strokes import (
+    across,
+    crank_arcs,
+    retraced,
+    stroke_arrows,
+    stroke_senses,
+)
+from .model import Drawing, Line, Scale, Text, standard_scale
 
-__all__ = ["KinematicsData", "kinematics_data", "kinematics_sheet", "SHEET_NAME"]
+__all__ = ["kinematics_sheet", "SHEET_NAME"]
 
 #: the sheet's name in its title block
 SHEET_NAME = "Kinematic analysis"
-#: samples of the diagrams per table step
-DIAGRAM_SAMPLES = 16
-
-
-@dataclass
-class KinematicsData:
-    """What the sheet draws: the table (``results``, as ``linkage analyze``), the chosen row
-    ``index``, the rows drawn as positions, the input speed ``omega`` (rad/s) the plans are at,
-    the ``plans`` (None for a slide input), the dense ``sweep`` over the table's travel for the
-    diagrams, with its turned coordinate ``psi`` (rad; m for a slide input) and the rows of the
-    output's extremes in it, and the ``notes`` the sheet states."""
-
-    mech: Mechanism
-    results: TableResults
-    index: int
-    rows: list[int]
-    omega: float
-    plans: Plans | None
-    sweep: Motion
-    psi: np.ndarray
-    extremes: dict[str, int]
-    notes: list[str] = field(default_factory=list)
-
-    @property
-    def motion(self) -> Motion:
-        return self.results.motion
-
-
-def kinematics_data(mech: Mechanism, position: int) -> KinematicsData:
-    """The numbers of the sheet at the table position ``position`` (1-based, as ``linkage plans
-    --position``). Raises InputError for a position outside the table or one that does not
-    assemble."""
-    results = kinematics_results(mech)
-    motion = results.motion
-    count = len(motion.phi)
-    if isinstance(position, bool) or not isinstance(position, (int, np.integer)) or not 1 <= position <= count:
-        raise InputError(f"position {position!r}: scheme '{mech.name}' has the table positions 1 to {count}")
-    i = int(position) - 1
-    if motion.status[i] != OK:
-        raise InputError(f"position {position}: scheme '{mech.name}' does not assemble there "
-                         f"({mech.coordinate.describe([motion.phi[i]])}): choose another position")
-    full_turn = mech.coordinate.is_angle and mech.input_range is None
-    rows = [k for k in range(count - 1 if full_turn else count) if motion.status[k] == OK]
-    notes = list(results.notes)
-    spec = section_of(mech, "dynamics")
-    omega = spec.mean_speed if spec is not None and spec.mean_speed else None
-    plans = None
-    if not mech.coordinate.is_angle:
-        notes.append("the plans of velocities and accelerations are built for a crank input only; this scheme is "
-                     "driven by a slide, so the sheet has the diagrams of the analogs per m of the slide instead")
-    else:
-        if omega is None:
-            omega = 1.0
-            notes.append("the scheme declares no speed: the plans are drawn at ω₁ = 1 rad/s (the analogs, "
-                         "in m/s per rad/s)")
-        at = analyze(mech, motion.phi[i:i + 1], order=2, omega=omega, eps=0.0)
-        plans = build_plans(at)
-    sweep, psi, extremes = _sweep(mech, motion.phi)
-    return KinematicsData(mech, results, i, rows, omega or 0.0, plans, sweep, psi, extremes, notes)
-
-
-def _sweep(mech: Mechanism, phi: np.ndarray) -> tuple[Motion, np.ndarray, dict[str, int]]:
-    """The motion over the table's travel at :data:`DIAGRAM_SAMPLES` per step, with the
-    output's extreme positions among its rows; the turned coordinate psi of each row."""
-    steps = len(phi) - 1
-    travel = float(phi[-1] - phi[0])
-    t = np.linspace(0.0, 1.0, steps * DIAGRAM_SAMPLES + 1)
-    wanted: dict[str, float] = {}
-    if mech.output is not None:
-        try:
-            ext = extreme_positions(mech)
-        except InputError:
-            ext = None
-        if ext is not None and ext.moves(mech.size):
-            for key, angle in (("max", ext.phi_max), ("min", ext.phi_min)):
-                frac = (angle - phi[0]) / travel
-                if mech.coordinate.is_angle and mech.input_range is None:
-                    frac = ((angle - phi[0]) * np.sign(travel)) % (2 * np.pi) / abs(travel)
-                if -1e-12 <= frac <= 1 + 1e-12:
-                    wanted[key] = float(np.clip(frac, 0.0, 1.0))
-    t = np.unique(np.concatenate([t, list(wanted.values())]))
-    sweep = analyze(mech, phi[0] + travel * t, order=2, on_failure="mask")
-    psi = np.abs(travel) * t if mech.coordinate.is_angle else phi[0] + travel * t
-    rows = {key: int(np.argmin(np.abs(t - frac))) for key, frac in wanted.items()}
-    return sweep, psi, rows
-
-
 # ----------------------------------------------------------------------------------------------
 # the sheet
 # ----------------------------------------------------------------------------------------------
@@ -424,13 +338,13 @@ def _positions(drawing: Drawing, data: KinematicsData, box, h: float) -> float:
         placer.place(xy, name, 0.9 * h, rings=(0.8, 1.5, 2.4))
     sweep_path = np.array([view.paper(p) for p in extreme_motion.point(label_point)
                            if np.all(np.isfinite(p))])
-    to_and_fro = strokes is not None and _retraced(sweep_path)
+    to_and_fro = strokes is not None and retraced(sweep_path)
     if to_and_fro:
-        normal = _across(sweep_path)
+        normal = across(sweep_path)
         numbers = {str(k + 1): p_label[k] for k in data.rows}
         sides = {str(k + 1): (1 if strokes["leaving"][k] == strokes["working"] else -1) for k in data.rows}
         edges = number_along_path(drawing, placer, numbers, sides, h, normal)
-        _stroke_arrows(drawing, data, view, label_point, strokes, normal, edges, placer, h)
+        stroke_arrows(drawing, data, view, label_point, strokes, normal, edges, placer, h)
     else:
         path = np.array(list(p_label.values()))
         middle = path.mean(axis=0) if len(path) else np.zeros(2)
@@ -444,7 +358,7 @@ def _positions(drawing: Drawing, data: KinematicsData, box, h: float) -> float:
         if t is not None:
             leader(drawing, xy, t.box())
     if strokes is not None and mech.coordinate.is_angle and mech.input_range is None:
-        _crank_arcs(drawing, data, view, strokes, placer, h)
+        crank_arcs(drawing, data, view, strokes, placer, h)
     legend = [f"Numbers 1–{len(data.rows)}: the table positions at point {label_point} (position 1: the "
               f"{_start_words(data)}), in the direction of rotation."]
     if data.extremes:
@@ -491,127 +405,6 @@ def _fit_positions(data: KinematicsData, box, h: float):
     scenes = {k: geometry.scene(k) for k in data.rows}
     pts = np.vstack([scene_points(s, geometry.unit) for s in scenes.values()])
     return mu, geometry, scenes, pts.min(axis=0), pts.max(axis=0)
-
-
-def _retraced(path: np.ndarray) -> bool:
-    """Whether a closed trajectory (mm) runs back over itself (a slider's, a rocker's point): the
-    area it encloses is under 2 % of its extent squared."""
-    if len(path) < 3:
-        return True
-    x, y = path[:, 0], path[:, 1]
-    area = 0.5 * abs(float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))))
-    extent = float(np.max(np.ptp(path, axis=0)))
-    return area <= 0.02 * extent ** 2
-
-
-def _across(path: np.ndarray) -> np.ndarray:
-    """The unit vector across a path (mm): normal to its principal direction, pointing up (or right)."""
-    d = np.linalg.svd(path - path.mean(axis=0), full_matrices=False)[2][0]
-    n = np.array([-d[1], d[0]])
-    return n if (n[1] > 1e-9 or (abs(n[1]) <= 1e-9 and n[0] > 0)) else -n
-
-
-def stroke_senses(data: KinematicsData) -> dict | None:
-    """The output's strokes: ``working`` (+1: the output quantity increases on the working
-    stroke), ``why`` (words), ``leaving`` (the sense in which the output leaves each table
-    row, ±1), ``rows`` (the sweep's rows of the working stroke's start and end). None when the
-    output has no extremes on the table's travel."""
-    if set(data.extremes) != {"max", "min"}:
-        return None
-    mech, motion = data.mech, data.motion
-    q = motion.quantity(mech.output.quantity)[0]
-    full = mech.coordinate.is_angle and mech.input_range is None
-    nxt = np.concatenate([q[1:-1], q[:1], q[1:2]]) if full else np.concatenate([q[1:], [2 * q[-1] - q[-2]]])
-    change = np.where(np.isfinite(nxt - q), nxt - q, 0.0)
-    leaving = np.where(change >= 0, 1, -1)
-    working, why = None, ""
-    for f in getattr(loads_of(mech), "forces", ()):
-        load = f.force
-        if getattr(load, "quantity", None) != mech.output.quantity:
-            continue
-        if isinstance(load, StrokeDiagram):
-            working, why = int(load.working), "as the load diagram of [[loads.forces]] declares"
-        elif isinstance(load, CycleTable):
-            mag = np.abs(np.asarray(load.values, float))
-            peak = int(np.argmax(mag))
-            if peak > 0 and np.isfinite(q[peak % len(q)]) and np.isfinite(q[peak - 1]):
-                working = 1 if q[peak % len(q)] - q[peak - 1] >= 0 else -1
-                why = "where the useful resistance of [[loads.forces]] acts"
-        if working is not None:
-            break
-    if working is None:
-        rows = data.extremes
-        t = data.psi
-        up = abs(float(t[rows["max"]] - t[rows["min"]]))
-        up = up if rows["max"] > rows["min"] else abs(float(t[-1] - t[0])) - up
-        working = 1 if up >= abs(float(t[-1] - t[0])) - up else -1
-        why = "the slower stroke (the scheme declares no load on its output)"
-    start, end = ("min", "max") if working > 0 else ("max", "min")
-    return {"working": working, "why": why, "leaving": leaving,
-            "rows": (data.extremes[start], data.extremes[end])}
-
-
-def _stroke_arrows(drawing: Drawing, data: KinematicsData, view, point: str, strokes: dict, normal, edges: dict,
-                   placer, h: float) -> None:
-    """The working stroke's travel of the output point as an arrow beyond its numbers, the idle
-    stroke's opposite, each named with the output's stroke (m, or degrees for an angle)."""
-    path = data.sweep.point(point)
-    a, b = strokes["rows"]
-    pa, pb = np.array(view.paper(path[a])), np.array(view.paper(path[b]))
-    n = np.asarray(normal, float)
-    centre = np.mean([view.paper(p) for p in data.motion.point(point)[data.rows]], axis=0)
-    value = data.sweep.quantity(data.mech.output.quantity)[0]
-    stroke = abs(float(value[data.extremes["max"]] - value[data.extremes["min"]]))
-    size = f"{math.degrees(stroke):.1f}°" if data.mech.output.quantity.endswith(".theta") else f"H = {stroke:.4g} m"
-    for side, (s, e), words in ((1, (pa, pb), "working stroke"), (-1, (pb, pa), "idle stroke")):
-        off = edges.get(side, 2 * h) + 2.5
-        s_off = s + side * n * max(off + side * float(np.dot(centre - s, n)), off)
-        e_off = e + side * n * max(off + side * float(np.dot(centre - e, n)), off)
-        shift = (s_off - s + e_off - e) / 2
-        s_off, e_off = s + shift, e + shift
-        if np.hypot(*(e_off - s_off)) < 6.0:
-            continue
-        drawing.add(Arrow(tuple(s_off), tuple(e_off), layer="dimensions", width=0.35, head=3.0))
-        for p, q in ((s, s_off), (e, e_off)):
-            drawing.add(Line((tuple(p + (q - p) * 0.15), tuple(q + (q - p) / max(np.hypot(*(q - p)), 1e-9) * 1.5)),
-                             layer="dimensions", width=0.18))
-        mid = (s_off + e_off) / 2
-        placer.place(tuple(mid), f"{words}, {size}", h, prefer=side * n, rings=(0.5, 1.0, 1.8, 3.0))
-
-
-def _crank_arcs(drawing: Drawing, data: KinematicsData, view, strokes: dict, placer, h: float) -> None:
-    """Arcs about the crank's pivot over the crank angles of the working stroke (φ_w) and of the
-    idle stroke (φ_i), arrowed in the direction of rotation."""
-    mech, sweep = data.mech, data.sweep
-    crank = mech.inputs[0]
-    pins = [p for p in mech.pairs.values() if isinstance(p, Revolute) and crank in p.links]
-    pivot = next((p for p in pins if mech.frame in p.links), None)
-    tip = next((p for p in pins if mech.frame not in p.links), None)
-    if pivot is None or tip is None:
-        return
-    o = sweep.point(pivot.point)[0]
-    rel = sweep.point(tip.point) - o
-    angle = np.unwrap(np.arctan2(rel[:, 1], rel[:, 0]))
-    radius_mm = float(np.nanmax(np.hypot(rel[:, 0], rel[:, 1]))) / view.scale.value
-    last = len(angle) - 1
-    a, b = strokes["rows"]
-    spans = {"working": (a, b), "idle": (b, a)}
-    for k, (name, (r0, r1)) in enumerate(spans.items()):
-        rows = np.arange(r0, r1 + 1) if r1 >= r0 else np.concatenate([np.arange(r0, last), np.arange(0, r1 + 1)])
-        turned = np.unwrap(angle[rows])
-        sweep_deg = abs(math.degrees(float(turned[-1] - turned[0])))
-        if sweep_deg < 2.0:
-            continue
-        r = radius_mm + (6.0 + 5.0 * k) * (1.0 if h >= 3.5 else 0.8)
-        t = np.linspace(float(turned[0]), float(turned[-1]), max(8, int(sweep_deg / 3)))
-        centre = np.array(view.paper(o))
-        arc = centre + r * np.column_stack([np.cos(t), np.sin(t)])
-        drawing.add(Line(tuple(map(tuple, arc[:-1])), layer="dimensions", width=0.3))
-        drawing.add(Arrow(tuple(arc[-2]), tuple(arc[-1]), layer="dimensions", width=0.3, head=2.5))
-        mid = arc[len(arc) // 2]
-        symbol = "φ_w" if name == "working" else "φ_i"
-        placer.place(tuple(mid), f"{symbol} = {sweep_deg:.1f}°", 0.9 * h, prefer=mid - centre,
-                     rings=(0.4, 0.9, 1.6, 2.5, 4.0))
 
 
 def _dashed(points, closed: bool) -> Line:
