@@ -199,3 +199,33 @@ def test_every_other_shipped_scheme_is_refused_naming_the_key():
 def test_no_dynamics_section_is_refused_naming_it():
     with pytest.raises(InputError, match=r"add \[dynamics\]"):
         dynamics_sheet(linkage.load("four_bar"))
+
+
+@pytest.mark.parametrize("paper", ["A2", "A3"])
+@pytest.mark.parametrize("name", SHIPPED_WITH_DYNAMICS)
+def test_nothing_overlaps_on_the_smaller_papers(name, paper):
+    """A2 and A3: the sheet is laid out in proportion to the paper, nothing overlaps or leaves the frame,
+    and no text is below 2.5 mm."""
+    drawing = dynamics_sheet(linkage.load(name), paper, TitleInfo(scheme=name))
+    assert drawing.paper == paper
+    assert layout_problems(drawing) == []
+    assert min(t.height for t in drawing.items if isinstance(t, Text)) >= 2.5 - 1e-9
+
+
+def test_the_tangents_hold_on_a3():
+    """On A3 (coarser scales) kl x μ_T / (ω_m² δ) is still the test's own tangent construction."""
+    mech = linkage.load("course_slider_crank")
+    drawing = dynamics_sheet(mech, "A3")
+    law = course_method(mech)
+    spec = dynamics_of(mech)
+    wm, delta = abs(spec.mean_speed), spec.delta
+    (kx, ky), (lx, ly) = points_k_l(drawing)
+    assert kx == pytest.approx(lx, abs=1e-9) and ky > ly
+    mu_t = drawing.scales["μ_T"].value
+    own = own_tangent_inertia(law.details["energy_change"], law.reduced.inertia_variable, wm, delta)
+    assert mu_t * (ky - ly) / (wm**2 * delta) == pytest.approx(own, abs=mu_t * 0.05 / (wm**2 * delta))
+
+
+def test_an_unknown_paper_is_refused():
+    with pytest.raises(InputError, match="A4"):
+        dynamics_sheet(linkage.load("course_slider_crank"), "A4")

@@ -78,8 +78,8 @@ def dynamics_sheet(mech: Mechanism, paper: str = "A1", title: TitleInfo = TitleI
     LinkageError
         What the dynamics pipeline raises (a partial input range, an undetermined speed ...).
     """
-    if paper not in ("A1", "A2"):
-        raise InputError(f"the dynamics sheet is laid out for A1 (or A2), got paper {paper!r}")
+    if paper not in ("A1", "A2", "A3"):
+        raise InputError(f"the dynamics sheet is laid out for A1, A2 or A3, got paper {paper!r}")
     if section_of(mech, "dynamics") is None:
         raise InputError(f"mechanism '{mech.name}': the dynamics sheet needs the scheme's [dynamics] section "
                          "(mean_speed or mean_rpm, delta, positions, inertia_0): add [dynamics]")
@@ -95,9 +95,9 @@ def dynamics_sheet(mech: Mechanism, paper: str = "A1", title: TitleInfo = TitleI
     layout = _Layout(free, drawing.paper)
     scales = _choose_scales(drawing, data, layout)
     _psi_panels(drawing, data, scales, layout)
-    _energy_inertia_panel(drawing, data, scales, layout.witt, layout.text)
-    _resistance_panel(drawing, mech, data, layout.resistance, layout.text)
-    _flywheel_panel(drawing, data, rim, layout.flywheel, layout.text)
+    _energy_inertia_panel(drawing, data, scales, layout.witt, layout.text, layout.heading)
+    _resistance_panel(drawing, mech, data, layout.resistance, layout.text, layout.heading)
+    _flywheel_panel(drawing, data, rim, layout.flywheel, layout.text, layout.heading)
     _notes(drawing, data, layout.notes, layout.text)
     scales_table(drawing, (layout.scales[0], layout.scales[3]), height=layout.text)
     return drawing
@@ -129,22 +129,44 @@ class _SheetData:
 
 
 class _Layout:
-    """The sheet's parts in the frame's free box (x0, y0, x1, y1), scaled from the A1 layout."""
+    """The sheet's parts in the frame's free box (x0, y0, x1, y1), in proportion to the paper.
+
+    A1: the ψ diagrams on the left half; on the right the energy–inertia diagram above, the
+    useful resistance and the flywheel below it, the scales and the notes left of the title block.
+    A2 and A3 (no room left of the title block): the scales and the notes under the ψ diagrams,
+    the useful resistance and the flywheel side by side above the title block. Text heights
+    (headings / text): A1 5 / 3.5 mm, A2 and A3 3.5 / 2.5 mm.
+    """
 
     def __init__(self, free, paper: str):
         x0, y0, x1, y1 = free
-        self.text = 3.5 if paper in ("A1", "A2") else 2.5
-        self.small = 2.5 if paper in ("A1", "A2") else 1.8
+        self.compact = paper != "A1"
+        self.heading = 3.5 if self.compact else 5.0
+        self.text = 2.5 if self.compact else 3.5
+        h = self.text
+        self.pad = 2.2 * h + 12.0 + 1.6 * self.heading   # a ψ panel's numbers, arrow heads and caption
         width, height = x1 - x0, y1 - y0
         split = x0 + 0.50 * width                          # left: the ψ diagrams
-        self.left = (x0, y0, split, y1)
         block_x = x1 - 185.0                               # the title block's left edge
-        low = y0 + 0.47 * height                           # the Wittenbauer diagram above this
+        block_top = y0 + 55.0 + 4.0                        # room above the title block
+        if not self.compact:
+            self.left = (x0, y0, split, y1)
+            low = y0 + 0.47 * height                       # the Wittenbauer diagram above this
+            self.witt = (split + 4, low, x1, y1)
+            self.flywheel = (block_x, block_top + 1.0, x1, low - 4)
+            self.resistance = (split + 4, y0 + 0.22 * height, block_x - 4, low - 4)
+            self.scales = (split + 4, y0, split + 4 + 0.30 * (block_x - split), y0 + 0.22 * height - 4)
+            self.notes = (self.scales[2] + 4, y0, block_x - 4, self.scales[3])
+            return
+        band = 10 * (2 * h + 1) + 2                        # the scales table: nine scales and a heading
+        self.left = (x0, y0 + band + 4, split, y1)
+        self.scales = (x0, y0, x0 + 50.0, y0 + band)
+        self.notes = (x0 + 54.0, y0, split, y0 + band)
+        low = block_top + 0.5 * (y1 - block_top)
         self.witt = (split + 4, low, x1, y1)
-        self.flywheel = (block_x, y0 + 60.0, x1, low - 4)
-        self.resistance = (split + 4, y0 + 0.22 * height, block_x - 4, low - 4)
-        self.scales = (split + 4, y0, split + 4 + 0.30 * (block_x - split), y0 + 0.22 * height - 4)
-        self.notes = (self.scales[2] + 4, y0, block_x - 4, self.scales[3])
+        middle = split + 4 + 0.42 * (x1 - split - 4)
+        self.resistance = (split + 4, block_top, middle - 4, low - 4)
+        self.flywheel = (middle, block_top, x1, low - 4)
 
 
 class _Scales(dict):
@@ -171,8 +193,18 @@ def _choose_scales(drawing: Drawing, data: _SheetData, layout: _Layout) -> _Scal
     s["I"] = drawing.use(Scale("μ_I", _fit(_span(data.inertia_variable, 0.0), min(heights[3], (wx1 - wx0) - 90)),
                                "(kg·m²)/mm"))
     swing = float(np.ptp(data.omega)) or 0.01 * data.mean_speed
-    s["omega"] = drawing.use(Scale("μ_ω", _fit(swing, 0.8 * heights[4]), "(rad/s)/mm"))
+    mu_omega = _fit(swing, 0.8 * heights[4])
+    top = max(float(np.max(data.omega)), data.mean_speed)
+    while (top - _omega_axis(data, mu_omega)) / mu_omega > heights[4] + 1e-9:   # the axis' round value too
+        mu_omega = _coarser(mu_omega)
+    s["omega"] = drawing.use(Scale("μ_ω", mu_omega, "(rad/s)/mm"))
     return s
+
+
+def _omega_axis(data: _SheetData, mu_omega: float) -> float:
+    """The round value of ω (rad/s) the ω(ψ) diagram's ψ axis is drawn at, a little below ω_min."""
+    swing = float(np.ptp(data.omega)) or 0.01 * data.mean_speed
+    return _nice_floor(float(np.min(data.omega)) - 0.1 * swing, mu_omega * 10)
 
 
 def _span(*values) -> float:
@@ -205,20 +237,19 @@ def _coarser(scale: float) -> float:
 
 #: the five ψ panels, top to bottom, and their share of the left column's height
 PANELS = (("M", 0.85), ("A", 0.85), ("T", 1.4), ("I", 1.15), ("omega", 0.75))
-_PANEL_PAD = 25.0  # mm of each panel for its title, the position numbers and gaps
 
 
 def _panel_heights(layout: _Layout) -> list[float]:
     x0, y0, x1, y1 = layout.left
     total = sum(w for _, w in PANELS)
-    return [(y1 - y0) * w / total - _PANEL_PAD for _, w in PANELS]
+    return [(y1 - y0) * w / total - layout.pad for _, w in PANELS]
 
 
 def _psi_panels(drawing: Drawing, data: _SheetData, scales: _Scales, layout: _Layout) -> None:
     x0, y0, x1, y1 = layout.left
     total = sum(w for _, w in PANELS)
     top = y1
-    h = layout.text
+    h, hd = layout.text, layout.heading
     for key, weight in PANELS:
         height = (y1 - y0) * weight / total
         box = (x0, top - height, x1, top)
@@ -227,30 +258,29 @@ def _psi_panels(drawing: Drawing, data: _SheetData, scales: _Scales, layout: _La
             series = [(data.moment, "M_red", False)]
             lines = [(data.driving, "M_d")]
             _psi_diagram(drawing, box, scales, "M", series, 0.0, "M_red, N·m",
-                         "Reduced moment of the loads M_red(ψ) and the driving moment M_d", h, lines=lines)
+                         "Reduced moment of the loads M_red(ψ) and the driving moment M_d", h, hd, lines=lines)
         elif key == "A":
             series = [(data.work_resistance, "A_c", False), (data.work_driving, "A_d", True)]
             _psi_diagram(drawing, box, scales, "A", series, 0.0, "A, J",
-                         "Works of the resistance A_c(ψ) and of the driving moment A_d(ψ)", h)
+                         "Works of the resistance A_c(ψ) and of the driving moment A_d(ψ)", h, hd)
         elif key == "T":
             _psi_diagram(drawing, box, scales, "T", [(data.energy, "ΔT", False)], 0.0, "ΔT, J",
-                         "Change of kinetic energy ΔT(ψ) = A_d + A_c", h)
+                         "Change of kinetic energy ΔT(ψ) = A_d + A_c", h, hd)
         elif key == "I":
             _psi_diagram(drawing, box, scales, "I", [(data.inertia_constant + data.inertia_variable, "I_red", False)],
                          data.inertia_constant, "I_red, kg·m²",
                          f"Reduced moment of inertia I_red(ψ) = I_0 + I''(ψ); axis at I_0 = "
-                         f"{_num(data.inertia_constant)} kg·m²", h)
+                         f"{_num(data.inertia_constant)} kg·m²", h, hd)
         else:
             wm = data.mean_speed
-            base = _nice_floor(float(np.min(data.omega)) - 0.1 * (float(np.ptp(data.omega)) or 0.01 * wm),
-                               scales["omega"].value * 10)
+            base = _omega_axis(data, scales["omega"].value)
             lines = [(wm, "ω_m")]
             _psi_diagram(drawing, box, scales, "omega", [(data.omega, "ω", False)], base, "ω, rad/s",
-                         f"Angular velocity of the crank ω(ψ); axis at ω = {_num(base)} rad/s", h, lines=lines)
+                         f"Angular velocity of the crank ω(ψ); axis at ω = {_num(base)} rad/s", h, hd, lines=lines)
 
 
 def _psi_diagram(drawing: Drawing, box, scales: _Scales, key: str, series, base: float, axis_label: str,
-                 caption: str, h: float, lines=()) -> None:
+                 caption: str, h: float, hd: float, lines=()) -> None:
     """One diagram over ψ in ``box``: the ψ axis at the value ``base``, the ordinates at the table
     positions, each series' polygon through its points (``(values, label, dashed)``), the
     horizontal ``lines`` ``(value, label)`` dashed, value ticks and the position numbers."""
@@ -271,8 +301,8 @@ def _psi_diagram(drawing: Drawing, box, scales: _Scales, key: str, series, base:
     ybot = oy + (lo - base) / mu.value
     drawing.add(Arrow((ox, min(ybot, oy)), (ox, ytop + 8), layer="diagrams", width=0.35, head=3.0))
     drawing.add(Text((ox + 2, ytop + 8), axis_label, height=h, anchor=("left", "top")))
-    drawing.add(Text((x0 + 2, y1 - 1), caption, height=h, anchor=("left", "top")))
-    placed = _position_numbers(drawing, ox, min(oy, ybot) - 1.5, psi / mu_psi.value, h * 0.7) + [psi_label.box()]
+    drawing.add(Text((x0 + 2, y1 - 1), caption, height=hd, anchor=("left", "top")))
+    placed = _position_numbers(drawing, ox, min(oy, ybot) - 1.5, psi / mu_psi.value, _small(h, 0.7)) + [psi_label.box()]
     main = series[0][0]
     for p, v in zip(psi, main):
         if abs(v - base) / mu.value > 0.3:
@@ -286,8 +316,8 @@ def _psi_diagram(drawing: Drawing, box, scales: _Scales, key: str, series, base:
         _free_label(drawing, view.paper((psi[k], values_k[k])), label, h, placed, gap=2.0)
     for value, label in lines:
         view.line([(0.0, value), (2 * np.pi, value)], layer="diagrams", width=0.35, dashed=True)
-        _free_label(drawing, view.paper((2 * np.pi, value)), f"{label} = {_num(value)}", h * 0.8, placed, gap=1.5)
-    _value_ticks(drawing, ox, oy, base, lo, hi, mu.value, h * 0.8)
+        _free_label(drawing, view.paper((2 * np.pi, value)), f"{label} = {_num(value)}", _small(h, 0.8), placed, gap=1.5)
+    _value_ticks(drawing, ox, oy, base, lo, hi, mu.value, _small(h, 0.8))
 
 
 def _position_numbers(drawing: Drawing, ox: float, y: float, x_mm, h: float) -> list:
@@ -317,6 +347,18 @@ def _value_ticks(drawing: Drawing, ox: float, oy: float, base: float, lo: float,
         drawing.add(Line(((ox - 1.5, y), (ox, y)), layer="diagrams", width=0.25))
         drawing.add(Text((ox - 2.0, y), _num(v, 4), height=h, anchor=("right", "middle")))
         v += step
+
+
+def _caption(at, right: float, hd: float, words: str, fewer: str) -> Text:
+    """A panel's heading at ``at`` (its upper left corner), in ``fewer`` words where ``words`` would
+    reach past ``right`` (mm)."""
+    text = Text(at, words, height=hd, anchor=("left", "top"))
+    return text if text.box()[2] <= right else Text(at, fewer, height=hd, anchor=("left", "top"))
+
+
+def _small(h: float, share: float) -> float:
+    """A minor text's height: ``share`` of the sheet's text height ``h``, not below 2.5 mm."""
+    return max(share * h, 2.5)
 
 
 def _nice_step(x: float) -> float:
@@ -354,7 +396,7 @@ def _num(value: float, digits: int = 4) -> str:
 WITT_WORDS = 6
 
 
-def _energy_inertia_panel(drawing: Drawing, data: _SheetData, scales: _Scales, box, h: float) -> None:
+def _energy_inertia_panel(drawing: Drawing, data: _SheetData, scales: _Scales, box, h: float, hd: float) -> None:
     """ΔT against I'' with its tangents, the points k and l and the segment kl."""
     x0, y0, x1, y1 = box
     drawing.region("energy-inertia diagram", box)
@@ -373,14 +415,14 @@ def _energy_inertia_panel(drawing: Drawing, data: _SheetData, scales: _Scales, b
     ytop = oy + hi / mu_t.value
     drawing.add(Arrow((ox, oy + lo / mu_t.value - 4), (ox, ytop + 10), layer="diagrams", width=0.35, head=3.0))
     drawing.add(Text((ox + 2, ytop + 10), "ΔT, J", height=h, anchor=("left", "top")))
-    drawing.add(Text((x0 + 2, y1 - 1), "Energy–inertia diagram (Wittenbauer): ΔT against I''", height=h,
+    drawing.add(Text((x0 + 2, y1 - 1), "Energy–inertia diagram (Wittenbauer): ΔT against I''", height=hd,
                      anchor=("left", "top")))
     pts = np.column_stack([data.inertia_variable, data.energy])
     view.line(pts, layer="diagrams", width=0.5)
     placed: list[tuple[float, float, float, float]] = []
     for i, p in enumerate(pts[:-1]):
         view.circle(p, 0.6, layer="diagrams", width=0.25, filled=True)
-        _free_label(drawing, view.paper(p), str(i + 1), h * 0.7, placed)
+        _free_label(drawing, view.paper(p), str(i + 1), _small(h, 0.7), placed)
     # the tangents: from k (l) on the ΔT axis through the touching point and on
     for intercept, slope, touch, name in ((t.intercept_upper, t.slope_upper, t.touch_upper, "k"),
                                           (t.intercept_lower, t.slope_lower, t.touch_lower, "l")):
@@ -408,9 +450,9 @@ def _energy_inertia_panel(drawing: Drawing, data: _SheetData, scales: _Scales, b
         "tangents take T'' at ω_max and ω_min,",
         f"Mertsalov at ω_m: they differ by at most max I'' = {_num(float(np.max(data.inertia_variable)))} kg·m²)",
     ]
-    text = Text((ox + width + 40, y1 - 3 * h), "\n".join(words), height=h * 0.8, anchor=("left", "top"))
+    text = Text((ox + width + 40, y1 - 3 * h), "\n".join(words), height=_small(h, 0.8), anchor=("left", "top"))
     if text.box()[2] > x1 - 2:                           # no room beside the diagram: under it
-        text = Text((x0 + 2, y0 + 1), "\n".join(words), height=h * 0.8, anchor=("left", "bottom"))
+        text = Text((x0 + 2, y0 + 1), "\n".join(words), height=_small(h, 0.8), anchor=("left", "bottom"))
     drawing.add(text)
 
 
@@ -499,14 +541,14 @@ def useful_resistance(mech: Mechanism, phi=None) -> list[dict]:
     return result
 
 
-def _resistance_panel(drawing: Drawing, mech: Mechanism, data: _SheetData, box, h: float) -> None:
+def _resistance_panel(drawing: Drawing, mech: Mechanism, data: _SheetData, box, h: float, hd: float) -> None:
     x0, y0, x1, y1 = box
     drawing.region("useful resistance", box)
-    drawing.add(Text((x0 + 2, y1 - 1), "Useful resistance P(s) over the stroke", height=h, anchor=("left", "top")))
+    drawing.add(_caption((x0 + 2, y1 - 1), x1 - 2, hd, "Useful resistance P(s) over the stroke", "Useful resistance P(s)"))
     diagrams = useful_resistance(mech, data.law.phi)
     if not diagrams:
         drawing.add(Text((x0 + 2, y1 - 3 * h), "The scheme declares no load diagram\n(a [[loads.forces]] entry "
-                         "with diagram = ... or cycle = [...])", height=h * 0.8, anchor=("left", "top")))
+                         "with diagram = ... or cycle = [...])", height=_small(h, 0.8), anchor=("left", "top")))
         return
     stroke = max(d["stroke"] for d in diagrams)
     peak = max(float(np.max(d["P"])) for d in diagrams) or 1.0
@@ -521,9 +563,9 @@ def _resistance_panel(drawing: Drawing, mech: Mechanism, data: _SheetData, box, 
     drawing.add(Text((end + 12, oy), f"s, {unit}", height=h, anchor=("left", "middle")))
     drawing.add(Arrow((ox, oy), (ox, top + 8), layer="diagrams", width=0.35, head=3.0))
     drawing.add(Text((ox + 2, top + 8), "P, N", height=h, anchor=("left", "top")))
-    _value_ticks(drawing, ox, oy, 0.0, 0.0, peak, mu_p.value, h * 0.8)
+    _value_ticks(drawing, ox, oy, 0.0, 0.0, peak, mu_p.value, _small(h, 0.8))
     view.line([(stroke, 0.0), (stroke, peak * 0.15)], layer="dimensions", width=0.18)
-    drawing.add(Text((end, oy - 1.5), f"H = {_num(stroke)} {unit}", height=h * 0.8, anchor=("right", "top")))
+    drawing.add(Text((end, oy - 1.5), f"H = {_num(stroke)} {unit}", height=_small(h, 0.8), anchor=("right", "top")))
     for d in diagrams:
         s, p, idle = d["s"], d["P"], d["idle"]
         work = np.column_stack([s[~idle], p[~idle]])
@@ -533,10 +575,18 @@ def _resistance_panel(drawing: Drawing, mech: Mechanism, data: _SheetData, box, 
         for q in work:
             view.circle(q, 0.6, layer="diagrams", width=0.25, filled=True)
         k = int(np.argmax(p))
-        view.text((s[k], p[k]), f"{d['label']} (along {d['quantity']})", offset=(-2.0, 1.0), height=h * 0.8,
-                  anchor=("right", "bottom"))
-    drawing.add(Text((ox, y0 + 1), "s: travel from the start of the working stroke", height=h * 0.7,
-                     anchor=("left", "bottom")))
+        peak_at = view.paper((s[k], p[k]))
+        label = Text((peak_at[0] - 2.0, peak_at[1] + 1.0), f"{d['label']} (along {d['quantity']})",
+                     height=_small(h, 0.8), anchor=("right", "bottom"))
+        if label.box()[0] < ox + 1.0:                   # would reach the P axis' values: right of the peak
+            label = Text((peak_at[0] + 2.0, peak_at[1] + 1.0), label.text, height=label.height,
+                         anchor=("left", "bottom"))
+        drawing.add(label)
+    note = Text((ox, y0 + 1), "s: travel from the start of the working stroke", height=_small(h, 0.7),
+                anchor=("left", "bottom"))
+    if note.box()[2] > x1 - 2:                          # fewer words in a narrow panel
+        note = Text(note.at, "s from the stroke's start", height=note.height, anchor=note.anchor)
+    drawing.add(note)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -544,16 +594,16 @@ def _resistance_panel(drawing: Drawing, mech: Mechanism, data: _SheetData, box, 
 # ----------------------------------------------------------------------------------------------
 
 
-def _flywheel_panel(drawing: Drawing, data: _SheetData, rim, box, h: float) -> None:
+def _flywheel_panel(drawing: Drawing, data: _SheetData, rim, box, h: float, hd: float) -> None:
     """The rim's half cross-section (axial section above the shaft's axis) and its numbers."""
     x0, y0, x1, y1 = box
-    drawing.add(Text((x0 + 2, y1 - 1), "Flywheel: a rim on the crank shaft", height=h, anchor=("left", "top")))
+    drawing.add(_caption((x0 + 2, y1 - 1), x1 - 2, hd, "Flywheel: a rim on the crank shaft", "Flywheel (a rim)"))
     law = data.law
     if rim is None:
         drawing.region("flywheel", box)
         drawing.add(Text((x0 + 2, y1 - 3 * h), f"No flywheel needed: I_0 = {_num(data.inertia_constant)} kg·m²\n"
                          f"exceeds I' = {_num(law.required_constant_inertia)} kg·m²;\n"
-                         f"the machine runs with δ = {law.delta_actual:.4g}", height=h * 0.8, anchor=("left", "top")))
+                         f"the machine runs with δ = {law.delta_actual:.4g}", height=_small(h, 0.8), anchor=("left", "top")))
         return
     rows = [["I_fw = I' − I_0", _num(rim.inertia), "kg·m²"],
             ["ρ (steel 7800, cast iron 7200)", _num(rim.density), "kg/m³"],
@@ -566,7 +616,7 @@ def _flywheel_panel(drawing: Drawing, data: _SheetData, rim, box, h: float) -> N
             ["check: m·D²/4", _num(rim.mass * rim.diameter**2 / 4), "kg·m²"]]
     th = min(h, 3.0)
     table_box = table(drawing, (x0 + 2, y0 + 2 + (len(rows) + 1) * (2 * th + 1)), ["Rim", "Value", "Unit"], rows,
-                      [0.6 * (x1 - x0 - 4), 0.25 * (x1 - x0 - 4), 0.15 * (x1 - x0 - 4)], height=th,
+                      [0.64 * (x1 - x0 - 4), 0.21 * (x1 - x0 - 4), 0.15 * (x1 - x0 - 4)], height=th,
                       name="flywheel table")
     # the sketch between the caption and the table
     drawing.region("flywheel", (x0, table_box[3] + 1, x1, y1))
@@ -574,7 +624,7 @@ def _flywheel_panel(drawing: Drawing, data: _SheetData, rim, box, h: float) -> N
     room_h, room_w = sy1 - sy0 - 4 * h, sx1 - sx0 - 50
     extent_m = rim.outer_diameter / 2 + rim.height   # above the axis: the rim and a margin
     mu_l = drawing.use(Scale("μ_l", _fit_pair(extent_m, room_h, rim.width * 2.5, room_w), "m/mm"))
-    cx, cy = sx0 + 20 + 0.5 * rim.width / mu_l.value, sy0 + 2 * h
+    cx, cy = sx0 + 10 * _small(h, 0.7) + 0.5 * rim.width / mu_l.value, sy0 + 2 * h
     view = drawing.view(mu_l, origin=(cx, cy))
     half_b, r, half_h = rim.width / 2, rim.diameter / 2, rim.height / 2
     corners = [(-half_b, r - half_h), (half_b, r - half_h), (half_b, r + half_h), (-half_b, r + half_h)]
@@ -582,15 +632,15 @@ def _flywheel_panel(drawing: Drawing, data: _SheetData, rim, box, h: float) -> N
     _hatch(drawing, section.points, 2.5)
     axis_end = half_b + rim.width * 0.6
     view.line([(-axis_end, 0.0), (axis_end, 0.0)], layer="dimensions", width=0.25, dashed=True)
-    view.text((axis_end, 0.0), "shaft axis", offset=(1.0, 0.0), height=h * 0.7, anchor=("left", "middle"))
+    view.text((axis_end, 0.0), "shaft axis", offset=(1.0, 0.0), height=_small(h, 0.7), anchor=("left", "middle"))
     view.line([(-axis_end, r), (axis_end, r)], layer="dimensions", width=0.18, dashed=True)
     # dimensions: D/2 (the mean radius) on the right, h on the left, b above
     xr = half_b + rim.width * 0.3
-    _dimension(view, (xr, 0.0), (xr, r), f"D/2 = {rim.diameter / 2:.3f} m", h * 0.7, side="right")
+    _dimension(view, (xr, 0.0), (xr, r), f"D/2 = {rim.diameter / 2:.3f} m", _small(h, 0.7), side="right")
     xl = -half_b - rim.width * 0.2
-    _dimension(view, (xl, r - half_h), (xl, r + half_h), f"h = {rim.height:.3f} m", h * 0.7, side="left")
+    _dimension(view, (xl, r - half_h), (xl, r + half_h), f"h = {rim.height:.3f} m", _small(h, 0.7), side="left")
     yb = r + half_h + rim.height * 0.35
-    _dimension(view, (-half_b, yb), (half_b, yb), f"b = {rim.width:.3f} m", h * 0.7, side="top")
+    _dimension(view, (-half_b, yb), (half_b, yb), f"b = {rim.width:.3f} m", _small(h, 0.7), side="top")
 
 
 def _fit_pair(height_m: float, room_h: float, width_m: float, room_w: float) -> float:
@@ -643,7 +693,7 @@ def _notes(drawing: Drawing, data: _SheetData, box, h: float) -> None:
         else f"no flywheel needed: the machine runs with δ = {law.delta_actual:.4g}",
         f"ω(ψ) with the flywheel: ω_max = {float(np.max(data.omega)):.4g}, ω_min = {float(np.min(data.omega)):.4g} rad/s",
     ]
-    size = h * 0.8
+    size = _small(h, 0.8)
     longest = max(len(line) for line in lines)
     size = min(size, (x1 - x0 - 4) / (0.7 * longest))
     drawing.add(Text((x0 + 2, y1 - 1), "\n".join(lines), height=size, anchor=("left", "top")))
