@@ -11,7 +11,7 @@ import pytest
 import linkage
 from linkage.course.project.frame import layout_problems
 from linkage.course.project.kinetostatics_sheet import compose_kinetostatics, kinetostatics_sheet
-from linkage.course.project.model import Arrow, Line
+from linkage.course.project.model import Arrow, Line, Text
 from linkage.errors import LinkageError
 from linkage.kinetostatics.plans import build_plans
 from linkage.kinetostatics.reactions import solve_reactions
@@ -43,6 +43,10 @@ def _at_position(sheet):
 def test_polygon_vectors_to_scale(sheet):
     """Every drawn polygon vector is in the drawing, and its length times μ_F is the value of
     build_plans (run again here at the one position) to 0.5 %."""
+    _check_vectors_to_scale(sheet)
+
+
+def _check_vectors_to_scale(sheet):
     mu_f = sheet.drawing.scales["μ_F"].value
     assert mu_f == sheet.mu_f
     _, _, plans = _at_position(sheet)
@@ -171,3 +175,36 @@ def test_refusals():
         kinetostatics_sheet(bare, 3, omega=10.0)
     with pytest.raises(LinkageError, match=r"position 40"):
         kinetostatics_sheet(linkage.load("course_slider_crank"), 40)
+
+
+#: (scheme, position, omega) drawn on the smaller papers
+SMALL = [("course_slider_crank", 12, None), ("six_bar", 3, 10.0)]
+
+
+@pytest.fixture(scope="module", params=[(c, paper) for c in SMALL for paper in ("A2", "A3")],
+                ids=[f"{c[0]}-{paper}" for c in SMALL for paper in ("A2", "A3")])
+def small_sheet(request):
+    (name, position, omega), paper = request.param
+    return compose_kinetostatics(linkage.load(name), position, paper, omega=omega)
+
+
+def test_small_paper_layout(small_sheet):
+    """On A2 and A3 nothing leaves the frame or covers the title block or another text; every
+    element of the A1 sheet is there; the texts are 3.5 mm (headings) and 2.5 mm (the rest)."""
+    drawing = small_sheet.drawing
+    assert layout_problems(drawing) == []
+    assert set(drawing.scales) == {"μ_l", "μ_F", "μ_v"}
+    regions = {r.name for r in drawing.regions}
+    steps = {p.step for p in small_sheet.plans.polygons}
+    assert {"lever", "lever table", "balancing moment", "scales"} <= regions
+    assert {f"polygon {s}" for s in steps} | {f"group {s}" for s in steps} | {f"table {s}" for s in steps} <= regions
+    heights = {t.height for t in drawing.items if isinstance(t, Text) and t.layer != "frame"}
+    assert heights <= {3.5, 2.5} and 3.5 in heights
+    texts = "\n".join(t.text for t in drawing.items if isinstance(t, Text))
+    assert texts.startswith("Kinetostatic analysis of") or "Kinetostatic analysis of" in texts
+    assert "Notes:" in texts and "Mb = −ΣM/ω₁" in texts
+
+
+def test_small_paper_vectors_to_scale(small_sheet):
+    """The polygons stay to scale on the smaller papers (A3 above all, where μ_F is coarsest)."""
+    _check_vectors_to_scale(small_sheet)

@@ -27,11 +27,14 @@ from ...model.scheme import section_of
 from ...report.results import forces_results
 from .model import Drawing, Text
 
-__all__ = ["DrawnVector", "ReactionSplit", "Labels", "analysis", "force_point", "global_point", "image", "name",
-           "num", "pair_point", "split_reactions", "unit", "wrapped"]
+__all__ = ["DrawnVector", "ReactionSplit", "Labels", "Sizes", "analysis", "force_point", "global_point", "image", "name",
+           "num", "pair_point", "sizes", "split_reactions", "unit",
+           "wrapped"]
 
 #: text heights: headings, labels, tables, mm
 HEADING, LABEL, SMALL = 5.0, 3.5, 2.5
+#: the width of A1 landscape, mm: a smaller paper's lengths are in proportion
+A1_WIDTH = 841.0
 #: the clear margin a label keeps from the lines drawn, mm
 CLEAR_MM = 1.2
 #: the clear margin between two labels, mm
@@ -78,6 +81,23 @@ class ReactionSplit:
     normal: np.ndarray
     tangential: np.ndarray
 
+
+@dataclass(frozen=True)
+class Sizes:
+    """The text heights of a sheet on one paper, mm: ``heading`` (the sheet's heading and the
+    boxes' titles), ``text`` (everything else), ``tables`` (the heights a table is tried at,
+    largest first); ``k`` the paper's width over A1's (the layout's lengths are in proportion)."""
+
+    heading: float
+    text: float
+    tables: tuple[float, ...]
+    k: float
+
+
+def sizes(drawing: Drawing) -> Sizes:
+    """A1: headings 5 mm, text 3.5 mm (tables 3.5 or 2.5 mm); A2, A3: headings 3.5 mm, text 2.5 mm."""
+    k = drawing.size[0] / A1_WIDTH
+    return Sizes(5.0, 3.5, (3.5, 2.5), k) if k > 0.9 else Sizes(3.5, 2.5, (2.5,), k)
 
 
 # ----------------------------------------------------------------------------------------------

@@ -1,17 +1,20 @@
 """The kinetostatics sheet of a course project: each Assur group drawn apart with its loads and
 reactions, the force polygons, Zhukovsky's lever and the check of the balancing moment.
 
-The A1 layout is the course's (docs/sheets.md). On the left, one row per Assur group in the order
-they are solved (from the farthest): the group drawn apart at the sheet's ``μ_l`` with its applied
-forces, gravity, inertia forces, inertia and applied moments (curved arrows with their values) and
-the reactions of its outer pairs, and its force polygon beside it at the sheet's one ``μ_F``;
-along the bottom the polygons' tables (every vector's length and value). On the right: the input
-link drawn apart with ``M_b`` and its polygon; Zhukovsky's lever (the velocity plan turned 90°
-clockwise at ``μ_v``, the forces at the images of their points); the lever's table of moments
-above the title block; the table comparing ``M_b`` by the polygons and by the lever, the scales
+The layout (docs/sheets.md) is in proportion to the paper: A1's text is 5 mm (headings) and
+3.5 mm, A2's and A3's 3.5 and 2.5 mm, and the room around the drawings scales with the paper's
+width. On the left, one row per Assur group in the order they are solved (from the farthest): the
+group drawn apart at the sheet's ``μ_l`` with its applied forces, gravity, inertia forces, inertia
+and applied moments (curved arrows with their values) and the reactions of its outer pairs, and
+its force polygon beside it at the sheet's one ``μ_F``. On the right: the input link drawn apart
+with ``M_b`` and its polygon; Zhukovsky's lever (the velocity plan turned 90° clockwise at
+``μ_v``, the forces at the images of their points). Along the bottom, beside and above the title
+block, packed in columns as low as they go: the polygons' tables (every vector's length and
+value), the lever's table of moments, ``M_b`` by the polygons and by the lever with the scales,
 and the notes. ``μ_l`` is the largest standard drawing at which every group fits its box (the
-largest at most 250 mm); ``μ_F`` draws the longest polygon vector 100–200 mm unless a polygon
-must be smaller to fit its box (a note says so).
+largest at most 250 mm on A1); ``μ_F`` draws the longest polygon vector 100–200 mm unless a
+polygon must be smaller to fit its box (a note says so); of the arrangements tried, the one
+drawing ``μ_l`` and ``μ_F`` least far from their best is kept.
 
 An outer revolute pair of a dyad whose link meets the other link in a revolute pair has its
 reaction split as the course does: ``R = Rⁿ + Rτ``, ``Rτ`` across the link from the link's moment
@@ -40,17 +43,15 @@ from ...model.mechanism import Prismatic, Revolute
 from ...report.drawing import Geometry
 from ...report.plan_drawings import nice_scale
 from .frame import CELL_PAD, TITLE_BLOCK_SIZE, WIDTH_MARGIN, TitleInfo, blank_sheet, scales_table, table
-from .kinetostatics_parts import (HEADING, LABEL, SUB, DrawnVector, Labels, ReactionSplit, analysis, force_point,
-                                  global_point, image, name, num, pair_point, split_reactions, unit, wrapped)
+from .kinetostatics_parts import (SUB, DrawnVector, Labels, ReactionSplit, analysis, force_point, global_point, image,
+                                  name, num, pair_point, sizes, split_reactions, unit, wrapped)
 from .model import Arrow, Circle, Drawing, Line, Scale, Text
 
 __all__ = ["DrawnVector", "ReactionSplit", "KinetostaticsSheet", "compose_kinetostatics", "kinetostatics_sheet",
            "split_reactions"]
 
-#: a box's title and the line under it, mm
-TITLE, SUBTITLE = 4.5, 3.5
-#: the text heights a table is tried at, largest first, mm
-TABLE_HEIGHTS = (3.5, 3.0, 2.5)
+#: the lengths below are A1's, mm; a smaller paper's are in proportion to its width (the text
+#: heights: :func:`.kinetostatics_parts.sizes`)
 #: a polygon vector shorter than this carries no label on the drawing (its table names it), mm
 LABELLED_MM = 4.0
 #: a force arrow on a group or on the lever when not to scale: the shortest and longest, mm
@@ -63,7 +64,7 @@ GROUP_MARGIN, POLYGON_MARGIN = 36.0, 12.0
 GROUP_MM, POLYGON_MM = 250.0, (100.0, 200.0)
 #: the heights the input links' band is tried at, fractions of the right column's (the first that draws
 #: μ_l and μ_F largest)
-INPUT_BAND = (0.30, 0.36, 0.42)
+INPUT_BAND = (0.30, 0.36, 0.42, 0.5, 0.6)
 #: the lever's longest vector below which it is called small, mm
 LEVER_MM = 60.0
 #: the shares of the left column's width the groups beside their polygons are tried at
@@ -74,8 +75,8 @@ INPUT_SHARE = (0.5, 0.62)
 ALONG_DEG = 4.0
 #: the radius of a moment's curved arrow, mm
 MOMENT_RADIUS = 8.0
-#: the room the two title lines of a box take, mm
-TITLE_ROOM = 14.0
+#: the gap between the tables and texts packed along the bottom, mm
+GAP_MM = 8.0
 
 
 @dataclass
@@ -115,7 +116,7 @@ def compose_kinetostatics(mech, position: int, paper: str = "A1", title: TitleIn
     position : int
         The table position, 1 .. N+1 (the positions of ``linkage forces``).
     paper : str
-        ``"A1"`` (the layout is made for it), ``"A2"``, ``"A3"``.
+        ``"A1"``, ``"A2"``, ``"A3"``: the layout and its text heights in proportion to the paper.
     title : TitleInfo
         The title block's names (the scheme's name when ``title.scheme`` is empty).
     omega : float, optional
@@ -135,27 +136,48 @@ def compose_kinetostatics(mech, position: int, paper: str = "A1", title: TitleIn
     return sheet
 
 
-def _arrow_mm(value: float, largest: float) -> float:
-    """The (not to scale) length of a force arrow on a group or the lever, mm."""
-    low, high = ARROW_MM
+def _arrow_mm(value: float, largest: float, k: float) -> float:
+    """The (not to scale) length of a force arrow on a group or the lever on a paper ``k`` times
+    A1's width, mm."""
+    low, high = k * ARROW_MM[0], k * ARROW_MM[1]
     return low + (high - low) * math.sqrt(value / largest) if largest > 0 else low
 
 
 def _widths(header: list[str], rows: list[list[str]], height: float) -> list[float]:
     """Column widths (mm) a table's texts fit at ``height`` mm."""
     columns = zip(header, *rows)
-    return [float(math.ceil(0.7 * WIDTH_MARGIN * height * max(len(t) for t in col) + 2 * CELL_PAD + 2))
-            for col in columns]
+    return [float(math.ceil(0.7 * WIDTH_MARGIN * height * max(len(line) for t in col for line in t.split("\n"))
+                            + 2 * CELL_PAD + 2)) for col in columns]
 
 
-def _room(box, margin: float) -> tuple[float, float]:
-    """The width and height (mm, at least 1) left in ``box`` under its titles, ``margin`` mm kept all round."""
-    return (max(box[2] - box[0] - 2 * margin, 1.0), max(box[3] - box[1] - 2 * margin - TITLE_ROOM, 1.0))
+def _room(box, margin: float, title_room: float) -> tuple[float, float]:
+    """The width and height (mm, at least 1) left in ``box`` under its titles (``title_room`` mm),
+    ``margin`` mm kept all round."""
+    return (max(box[2] - box[0] - 2 * margin, 1.0), max(box[3] - box[1] - 2 * margin - title_room, 1.0))
 
 
-def _table_height(rows: int, height: float) -> float:
-    """The height (mm) of a table of one header line and ``rows`` rows at text ``height`` mm."""
-    return (rows + 1) * (2 * height + 1)
+def _table_height(rows: int, height: float, header: list[str] = ("",)) -> float:
+    """The height (mm) of a table of ``header`` (its lines) and ``rows`` rows at text ``height`` mm."""
+    lines = max(h.count("\n") + 1 for h in header)
+    return (rows + 1) * (2 * height + 1) + 1.6 * height * (lines - 1)
+
+
+def _pack(blocks: list[tuple[float, float]], spaces: list, gap: float) -> list[tuple[float, float]] | None:
+    """The upper left corners (mm) of ``blocks`` (width, height mm) put in order into ``spaces``
+    (boxes), in columns from the left, each column from the top; None when they do not all fit."""
+    corners: list[tuple[float, float]] = []
+    for sx0, sy0, sx1, sy1 in spaces:
+        x, y, column = sx0, sy1, 0.0
+        while len(corners) < len(blocks):
+            w, h = blocks[len(corners)]
+            if y - h >= sy0 and x + w <= sx1:
+                corners.append((x, y))
+                y, column = y - h - gap, max(column, w)
+            elif column > 0 and sy1 - h >= sy0 and x + column + gap + w <= sx1:
+                x, y, column = x + column + gap, sy1, 0.0
+            else:
+                break
+    return corners if len(corners) == len(blocks) else None
 
 
 class _Composer:
@@ -167,6 +189,10 @@ class _Composer:
         self.mech = self.plans.motion.mechanism
         self.free = free
         self.labels = Labels(self.d)
+        self.s = sizes(self.d)
+        self.k = self.s.k
+        self.title_room = self.s.heading + 2.6 * self.s.text + 3.0     # a title line and two subtitle lines
+        self.margin = GROUP_MARGIN * self.k * (1.0 if self.k > 0.9 else 0.75)  # the room kept around a group
         for item in self.d.items:
             if isinstance(item, Text):
                 self.labels.taken(item.box())
@@ -180,46 +206,86 @@ class _Composer:
     # -- layout --------------------------------------------------------------------------------
     def compose(self) -> None:
         x0, y0, x1, y1 = self.free
-        self._heading((x0 + 5, y1 - 3))
-        top = y1 - 12
+        top = self._heading((x0 + 5, y1 - 3), x1 - x0 - 10) - 3
         right_w = 0.40 * (x1 - x0)
-        left = (x0 + 4, y0 + 4, x1 - right_w - 4, top)
-        right = (x1 - right_w + 4, y0 + 4, x1 - 4, top)
-        # the polygons' tables along the bottom of the left column
-        height, tables = self._polygon_tables_plan(left[2] - left[0])
-        band_top = left[1] + 6 + max(_table_height(len(rows), height) for _, rows, _ in tables)
-        # the groups' rows above them: the group apart and its polygon beside it
-        # the input links on the right, each with its polygon
+        gap = GAP_MM * self.k
+        # along the bottom, beside and above the title block: the polygons' tables, the lever's
+        # table, M_b, the scales and the notes (the notes as the scales chosen below make them)
+        bw, bh = TITLE_BLOCK_SIZE
+        spaces = lambda band: [(x0 + 4, y0 + 4, x1 - bw - gap / 2, band), (x1 - bw, y0 + bh + gap / 2, x1 - 2, band)]
+        height, tables = self._polygon_tables_plan(x1 - x0 - bw - gap)
         lever_table = self._lever_rows()
-        lever_h_t = self._fitting_height(*lever_table[:2], TITLE_BLOCK_SIZE[0])
-        lever_table_at = (x1 - TITLE_BLOCK_SIZE[0], y0 + TITLE_BLOCK_SIZE[1] + 6)
-        band_c = lever_table_at[1] + _table_height(len(lever_table[1]), lever_h_t) + 2
-        # the groups above the tables: each beside its polygon, or a lone group above its polygon when
-        # that draws it larger (a long group); the input links' band as low as draws them as large
-        area = (left[0], band_top + 2, left[2], top)
-        layouts = [self._beside(area, share) for share in GROUP_SHARE]
-        if len(self.groups) == 1:
-            layouts.insert(0, self._stacked(area))
-        column_h = top - right[1]
-        candidates = [(groups + self._inputs(right, fraction * column_h, share), fraction * column_h)
-                      for fraction in INPUT_BAND for share in INPUT_SHARE for groups in layouts]
+        lever_h = self._fitting_height(*lever_table, bw)
+        notes: list[str] = []
+        for _ in range(3):
+            blocks = self._bottom_blocks(tables, height, lever_table, lever_h, self.sheet.notes + notes)
+            band = max(h for _, h in blocks) + y0 + 4
+            while _pack(blocks, spaces(band), gap) is None and band < y0 + 0.7 * (y1 - y0):
+                band += 2.0
+            area = (x0 + 4, band + gap / 2, x1 - right_w - 4, top)       # the groups, each beside its polygon
+            right = (x1 - right_w + 4, band + gap / 2, x1 - 4, top)      # the input links and the lever
+            layouts = [self._beside(area, share) for share in GROUP_SHARE]
+            if len(self.groups) == 1:
+                layouts.insert(0, self._stacked(area))
+            column_h = top - right[1]
+            candidates = [(groups + self._inputs(right, fraction * column_h, share), fraction * column_h)
+                          for fraction in INPUT_BAND for share in INPUT_SHARE for groups in layouts]
 
-        def drawn(candidate) -> tuple:                  # the lever not small, then μ_l and μ_F largest
-            lever = (right[0], band_c + 4, right[2], top - candidate[1] - 2)
-            return (self._lever_longest() / self._lever_scale(lever) < LEVER_MM, *self._scales(candidate[0]))
-
-        boxes, input_h = min(candidates, key=drawn)
+            # the lever not small, then μ_l and μ_F the least far from their best
+            scales = [self._scales(c[0]) for c in candidates]
+            best = np.min(scales, axis=0)
+            drawn = [(self._lever_longest() / self._lever_scale((*right[:3], top - input_h - 2)) < LEVER_MM * self.k,
+                      float(np.max(np.divide(pair, best))), *pair) for (_, input_h), pair in zip(candidates, scales)]
+            boxes, input_h = candidates[min(range(len(candidates)), key=drawn.__getitem__)]
+            lever_box = (right[0], right[1], right[2], top - input_h - 2)
+            found = self._scale_notes(self._scales(boxes)[1]) + self._lever_notes(self._lever_scale(lever_box))
+            if found == notes:
+                break
+            notes = found
+        self.sheet.notes += notes
         self._choose_scales(boxes)
         for polygon, group_box, polygon_box in boxes:
             self._group(polygon, group_box)
             self._polygon(polygon, polygon_box)
-        self._polygon_tables(left, height, tables)
-        lever_box = (right[0], band_c + 4, right[2], top - input_h - 2)
         self._lever(lever_box)
-        self._lever_table(lever_table, lever_table_at, lever_h_t)
-        self._checks((right[0], band_c, x1 - TITLE_BLOCK_SIZE[0] - 5, y0 + 2))
+        corners = _pack(blocks, spaces(band), gap) or [(x0 + 4, band)] * len(blocks)
+        for (x, y), (polygon, (header, _, widths)) in zip(corners, zip(self.rows, tables)):
+            caption = self.d.add(Text((x, y), f"Polygon of {polygon.step}", height=self.s.text,
+                                      anchor=("left", "top")))
+            self.labels.taken(caption.box())
+            table(self.d, (x, y - 1.6 * self.s.text - 1), header, self._polygon_rows(polygon, self.mu_f), widths,
+                  height=height, name=f"table {polygon.step}")
+        self._lever_table(lever_table, corners[len(tables)], lever_h)
+        self._checks(*corners[len(tables) + 1:], blocks[-1][0])
 
-    def _heading(self, at) -> None:
+    def _bottom_blocks(self, tables, height: float, lever_table, lever_h: float, notes: list[str]) -> list:
+        """(width, height) mm of what goes along the bottom: each polygon's table under its caption,
+        the lever's table, M_b (its formula and table), the scales, the notes."""
+        text = self.s.text
+        blocks = [(sum(widths), 1.6 * text + 1 + _table_height(len(rows), height, header))
+                  for header, rows, widths in tables]
+        blocks.append((sum(_widths(*lever_table, lever_h)), _table_height(len(lever_table[1]), lever_h,
+                                                                            lever_table[0])))
+        header, rows = self._mb_rows(0.0, 0.0)
+        mb_w = max(sum(_widths(header, rows, self.s.tables[0])), 0.7 * text * 32)
+        blocks.append((mb_w + self._gap() / 2 + self._scales_width(),
+                       max(2.6 * text + 3 + _table_height(2, self.s.tables[0], header),
+                           _table_height(3, self.s.tables[0]))))
+        notes_w = TITLE_BLOCK_SIZE[0] - 2
+        lines = self._notes_text(notes, notes_w).count("\n") + 1
+        blocks.append((notes_w, text * (1.6 * lines - 0.6)))
+        return blocks
+
+    def _gap(self) -> float:
+        return GAP_MM * self.k
+
+    def _scales_width(self) -> float:
+        """The scales table's width (:func:`.frame.scales_table`'s rule), mm."""
+        height = self.s.tables[0]
+        return max(40.0, float(np.ceil(0.7 * WIDTH_MARGIN * height * len("μ_v = 0.0025 (m/s)/mm") + 2 * CELL_PAD + 1)))
+
+    def _heading(self, at, width: float) -> float:
+        """The sheet's heading at ``at`` (its upper left corner), in lines of ``width`` mm; returns its lower edge, mm."""
         motion = self.plans.motion
         turned = float(table_positions_deg(motion.phi, motion.direction)[self.i])
         phi = (math.degrees(float(motion.phi[self.i])) + 180.0) % 360.0 - 180.0
@@ -227,12 +293,19 @@ class _Composer:
         text = (f"Kinetostatic analysis of '{self.mech.name}' at position {self.i + 1} of {len(motion.phi) - 1} "
                 f"(turned {num(turned)}° from position 1, input angle {num(phi)}°, ω₁ = {num(omega)} rad/s, "
                 f"ε₁ = {num(float(motion.eps[self.i]))} rad/s²)")
-        self.d.add(Text(at, text, height=HEADING, anchor=("left", "top")))
-        self.labels.taken(self.d.items[-1].box())
+        text = wrapped(text, 0.7 * WIDTH_MARGIN * self.s.heading, width)
+        item = self.d.add(Text(at, text, height=self.s.heading, anchor=("left", "top")))
+        self.labels.taken(item.box())
+        return item.box()[1]
 
     def _title(self, box, title: str, subtitle: str) -> None:
-        for at, text, h in (((box[0] + 2, box[3] - 1), title, TITLE), ((box[0] + 2, box[3] - 2.5 - TITLE), subtitle,
-                                                                          SUBTITLE)):
+        """A box's title (at the text's height when the heading's is too wide) and, under it, its
+        subtitle in at most two lines of the box's width."""
+        width = box[2] - box[0] - 4
+        high = self.s.heading if 0.7 * WIDTH_MARGIN * self.s.heading * len(title) <= width else self.s.text
+        subtitle = "\n".join(wrapped(subtitle, 0.7 * WIDTH_MARGIN * self.s.text, width).split("\n")[:2])
+        for at, text, h in (((box[0] + 2, box[3] - 1), title, high),
+                            ((box[0] + 2, box[3] - 2.5 - self.s.heading), subtitle, self.s.text)):
             item = self.d.add(Text(at, text, height=h, anchor=("left", "top")))
             self.labels.taken(item.box())
 
@@ -267,30 +340,33 @@ class _Composer:
         need = 0.0
         for polygon, box, _ in boxes:
             span = np.ptp(self._link_points(polygon.links), axis=0)
-            room = _room(box, GROUP_MARGIN)
-            need = max(need, span[0] / room[0], span[1] / room[1], max(span) / GROUP_MM)
+            room = _room(box, self.margin, self.title_room)
+            need = max(need, span[0] / room[0], span[1] / room[1], max(span) / (GROUP_MM * self.k))
         mu_l = nice_scale(need)
         longest = max(float(np.hypot(*v.vector[i])) for p in self.plans.polygons for v in p.forces)
         need = longest / POLYGON_MM[1]
         for polygon, _, box in boxes:
             span = np.ptp(self._chain(polygon), axis=0)
-            room = _room(box, POLYGON_MARGIN)
+            room = _room(box, POLYGON_MARGIN * self.k, self.title_room)
             need = max(need, span[0] / room[0], span[1] / room[1])
         return mu_l, nice_scale(need)
 
-    def _choose_scales(self, boxes) -> None:
-        i = self.i
-        self.mu_l, self.mu_f = self._scales(boxes)
-        mu_f = self.mu_f
+    def _scale_notes(self, mu_f: float) -> list[str]:
+        """The notes μ_F (N/mm) calls for: chosen so the polygons fit, a polygon small."""
+        i, notes = self.i, []
         longest = max(float(np.hypot(*v.vector[i])) for p in self.plans.polygons for v in p.forces)
         if longest / mu_f < POLYGON_MM[0]:
-            self.sheet.notes.append(f"μ_F is chosen so the polygons fit their places: the longest vector is "
-                                    f"{longest / mu_f:.0f} mm")
+            notes.append(f"μ_F is chosen so the polygons fit their places: the longest vector is "
+                         f"{longest / mu_f:.0f} mm")
         for polygon in self.plans.polygons:
             top = max(float(np.hypot(*v.vector[i])) for v in polygon.forces)
-            if top / mu_f < TINY_MM:
-                self.sheet.notes.append(f"the polygon of {polygon.step} is small at μ_F = {num(mu_f)} N/mm (its "
-                                        f"longest vector {top / mu_f:.1f} mm): its table gives the values")
+            if top / mu_f < TINY_MM * self.k:
+                notes.append(f"the polygon of {polygon.step} is small at μ_F = {num(mu_f)} N/mm (its "
+                             f"longest vector {top / mu_f:.1f} mm): its table gives the values")
+        return notes
+
+    def _choose_scales(self, boxes) -> None:
+        self.mu_l, self.mu_f = self._scales(boxes)
         self.sheet.mu_l, self.sheet.mu_f = self.mu_l, self.mu_f
         self.d.use(Scale("μ_l", self.mu_l, "m/mm"))
         self.d.use(Scale("μ_F", self.mu_f, "N/mm"))
@@ -319,13 +395,13 @@ class _Composer:
         d, i = self.d, self.i
         pts = self._link_points(polygon.links)
         centre_q = (pts.min(axis=0) + pts.max(axis=0)) / 2
-        centre_mm = ((box[0] + box[2]) / 2, (box[1] + box[3] - TITLE_ROOM) / 2)
+        centre_mm = ((box[0] + box[2]) / 2, (box[1] + box[3] - self.title_room) / 2)
         view = d.view(Scale("μ_l", self.mu_l, "m/mm"), origin=centre_mm, at=tuple(centre_q)).paper
         shown = self._shown_forces(polygon)
         largest = max([float(np.hypot(*v)) for _, v, _ in shown] + [0.0])
         shown = [(np.array(view(at)), v, label) for at, v, label in shown if float(np.hypot(*v)) > 1e-9 * largest]
         links_mm = np.array([view(q) for q in pts])
-        inner = (box[0] + 6, box[1] + 6, box[2] - 6, box[3] - TITLE_ROOM - 6)
+        inner = (box[0] + 6, box[1] + 6, box[2] - 6, box[3] - self.title_room - 6)
         arrows = self._group_arrows(shown, links_mm, largest, True)
         to_scale = all(inner[0] <= e[0] <= inner[2] and inner[1] <= e[1] <= inner[3]
                        for start, end, *_ in arrows for e in (start, end))
@@ -374,12 +450,12 @@ class _Composer:
         for centre, value, _ in moments:
             self._curved(centre, value)
         for p, label in pins:                           # the labels once every line is drawn
-            self.labels.add(p, label, box, height=LABEL, prefer=(-1, 1), gap=2.5)
+            self.labels.add(p, label, box, height=self.s.text, prefer=(-1, 1), gap=2.5)
         for start, end, far, label in arrows:
-            self.labels.add(far, label, box, height=LABEL, prefer=far - (start + end) / 2)
+            self.labels.add(far, label, box, height=self.s.text, prefer=far - (start + end) / 2)
         for centre, value, label in moments:
-            self.labels.add(centre, f"{label} = {num(value)} N·m", box, height=LABEL, prefer=(0.3, -1),
-                            gap=MOMENT_RADIUS + 2.0)
+            self.labels.add(centre, f"{label} = {num(value)} N·m", box, height=self.s.text, prefer=(0.3, -1),
+                            gap=self._radius() + 2.0)
 
     def _group_arrows(self, shown, links_mm: np.ndarray, largest: float, to_scale: bool) -> list:
         """(start, end, the end away from the point, label) of each force on a group, mm: from its
@@ -389,7 +465,7 @@ class _Composer:
         for at, vector, label in shown:
             size = float(np.hypot(*vector))
             u = unit(vector)
-            length = size / self.mu_f if to_scale else _arrow_mm(size, largest)
+            length = size / self.mu_f if to_scale else _arrow_mm(size, largest, self.k)
             towards = links_mm - at
             reach = np.hypot(towards[:, 0], towards[:, 1])
             along = (reach > 1.0) & (towards @ u > np.cos(np.radians(ALONG_DEG)) * reach)
@@ -419,12 +495,16 @@ class _Composer:
         self.d.add(Line(tuple(tuple(map(float, p)) for p in corners), layer="links", width=0.7, closed=True))
         self.labels.mark(corners + corners[:1])
 
+    def _radius(self) -> float:
+        """A moment's curved arrow's radius, mm."""
+        return max(MOMENT_RADIUS * self.k, 5.0)
+
     def _curved(self, centre: np.ndarray, value: float) -> None:
         """A moment: an arc of 240° about ``centre`` (mm), CCW for a positive ``value``, its head at
         the arc's end."""
         sense = 1.0 if value > 0 else -1.0
         angles = np.radians(np.linspace(-30, 210, 31)) if sense > 0 else np.radians(np.linspace(210, -30, 31))
-        pts = centre + MOMENT_RADIUS * np.column_stack([np.cos(angles), np.sin(angles)])
+        pts = centre + self._radius() * np.column_stack([np.cos(angles), np.sin(angles)])
         self.d.add(Line(tuple(tuple(map(float, p)) for p in pts[:-1]), layer="forces", width=0.5))
         self.d.add(Arrow(tuple(map(float, pts[-4])), tuple(map(float, pts[-1])), layer="forces", width=0.5, head=3.0))
         self.labels.mark(pts)
@@ -483,7 +563,7 @@ class _Composer:
         seq = self._sequence(polygon)
         chain = self._chain(polygon) / mu
         lo, hi = chain.min(axis=0), chain.max(axis=0)
-        origin = np.array([(box[0] + box[2]) / 2, (box[1] + box[3] - TITLE_ROOM) / 2]) - (lo + hi) / 2
+        origin = np.array([(box[0] + box[2]) / 2, (box[1] + box[3] - self.title_room) / 2]) - (lo + hi) / 2
         centroid = origin + chain.mean(axis=0)
         ends: dict[str, tuple[np.ndarray, np.ndarray]] = {}
         here = origin.copy()
@@ -515,7 +595,7 @@ class _Composer:
         self.labels.mark([origin])
         for mid, text in texts:                         # the labels once every line is drawn
             if mid is not None:
-                self.labels.add(mid, text, box, height=LABEL, prefer=mid - centroid, gap=1.2)
+                self.labels.add(mid, text, box, height=self.s.text, prefer=mid - centroid, gap=1.2)
 
     def _vector(self, step, label, kind, start, end, value, text, width) -> tuple[np.ndarray | None, str]:
         """Draw a polygon vector; returns its midpoint (None when too short to label) and label."""
@@ -537,30 +617,18 @@ class _Composer:
     def _polygon_tables_plan(self, width: float) -> tuple[float, list]:
         """The text height the polygons' tables fit ``width`` mm side by side at, and each table's
         (header, rows, widths); rows sized with lengths at 1 N/mm (the widest they can be)."""
-        header = ["force", "length, mm", "value, N"]
-        for height in TABLE_HEIGHTS:
+        header = ["force", "length, mm", "value, N"] if self.k > 0.9 else ["force", "length,\nmm", "value,\nN"]
+        for height in self.s.tables:
             tables = []
             for polygon in self.rows:
                 rows = self._polygon_rows(polygon, 1.0)
                 tables.append((header, rows, _widths(header, rows, height)))
-            if sum(sum(w) for *_, w in tables) + 8 * (len(tables) - 1) <= width or height == TABLE_HEIGHTS[-1]:
-                return height, tables
-        raise AssertionError("unreachable")
-
-    def _polygon_tables(self, left, height: float, tables) -> None:
-        x = left[0]
-        gap = (left[2] - left[0] - sum(sum(w) for *_, w in tables)) / max(len(tables), 1)
-        x += gap / 2
-        top = left[1] + 6 + max(_table_height(len(rows), height) for _, rows, _ in tables)
-        for polygon, (header, _, widths) in zip(self.rows, tables):
-            caption = self.d.add(Text((x, top + 1), f"Polygon of {polygon.step}", height=SUBTITLE))
-            self.labels.taken(caption.box())
-            table(self.d, (x, top), header, self._polygon_rows(polygon, self.mu_f), widths, height=height,
-                  name=f"table {polygon.step}")
-            x += sum(widths) + gap
+            if sum(sum(w) for *_, w in tables) + GAP_MM * self.k * (len(tables) - 1) <= width:
+                break
+        return height, tables
 
     def _fitting_height(self, header, rows, width: float) -> float:
-        return next((h for h in TABLE_HEIGHTS if sum(_widths(header, rows, h)) <= width), TABLE_HEIGHTS[-1])
+        return next((h for h in self.s.tables if sum(_widths(header, rows, h)) <= width), self.s.tables[-1])
 
     def _lever_rows(self) -> tuple[list[str], list[list[str]]]:
         """The header and rows of the lever's table (the arm ``h`` at ``μ_v``, filled once it is known)."""
@@ -580,44 +648,55 @@ class _Composer:
             rows.append([f"{name(m.label)}·ω{m.link.translate(SUB)}", num(float(m.value[i])), "—",
                          zeroed(float(m.contribution[i]))])
         rows = [[r[0], r[1], "000.0" if isinstance(r[2], float) else r[2], r[3]] for r in rows]
-        return ["force at its image", "F, N", "h, mm", "F·h·μ_v, N·m/s"], rows
+        return ["force at\nits image", "F, N", "h, mm", "F·h·μ_v,\nN·m/s"], rows
 
-    def _lever_table(self, header_rows, bottom_left, height: float) -> None:
+    def _lever_table(self, header_rows, top_left, height: float) -> None:
         header, rows = header_rows
         lever, i = self.plans.lever, self.i
         for row, f in zip(rows, lever.forces):
             size = float(np.hypot(*f.force[i]))
             row[2] = f"{abs(float(f.moment[i])) / size / self.mu_v:.1f}" if size > 0 else "0.0"
-        top = bottom_left[1] + _table_height(len(rows), height)
-        table(self.d, (bottom_left[0], top), header, rows, _widths(header, rows, height), height=height,
-              name="lever table")
+        table(self.d, top_left, header, rows, _widths(header, rows, height), height=height, name="lever table")
 
-    def _checks(self, box) -> None:
-        """``M_b`` by the lever's formula, the table comparing it with the polygons', the scales and
-        the notes, top down in ``box``."""
-        d, i, lever = self.d, self.i, self.plans.lever
-        x0, top, x1, _ = box
+    def _mb_rows(self, mb_poly: float, mb_lever: float) -> tuple[list[str], list[list[str]]]:
+        """The header and rows of the table comparing ``M_b`` (N m) by the polygons and by the lever."""
+        diff = (mb_lever - mb_poly) / abs(mb_poly) * 100.0 if mb_poly != 0 else 0.0
+        return (["balancing\nmoment Mb", "Mb, N·m", "difference,\n%"],
+                [["by the force polygons", num(mb_poly), ""],
+                 ["by Zhukovsky's lever", num(mb_lever), num(round(diff, 3)) if abs(diff) >= 1e-3 else "0.000"]])
+
+    def _notes_text(self, notes: list[str], width: float) -> str:
+        """The numbered notes in lines of ``width`` mm under "Notes:"."""
+        notes = ["Arrows on the lever show the lines and senses of the forces, not to scale: its table gives "
+                 "the values; the polygons are drawn at μ_F."] + notes
+        return "Notes:\n" + "\n".join(wrapped(f"{k + 1}. {line}", 0.7 * WIDTH_MARGIN * self.s.text, width)
+                                      for k, line in enumerate(notes))
+
+    def _checks(self, at, notes_at, width: float) -> None:
+        """``M_b`` by the lever's formula, the table comparing it with the polygons' and right of
+        them the scales, at ``at`` (upper left, mm); the notes in lines of ``width`` mm at ``notes_at``."""
+        d, i, lever, height = self.d, self.i, self.plans.lever, self.s.tables[0]
+        x0, top = at
         total = sum(float(f.moment[i]) for f in lever.forces) + sum(float(m.contribution[i]) for m in lever.moments)
         mb_lever = float(lever.balancing_moment[i])
         mb_poly = float(next(m.value[i] for m in self.inputs[0].moments if m.kind == "balancing"))
         self.sheet.mb_lever, self.sheet.mb_polygons = mb_lever, mb_poly
         formula = d.add(Text((x0, top), f"Mb = −ΣM/ω₁ =\n−({num(total)})/({num(float(lever.omega[i]))}) = "
-                             f"{num(mb_lever)} N·m", height=SUBTITLE, anchor=("left", "top")))
+                             f"{num(mb_lever)} N·m", height=self.s.text, anchor=("left", "top")))
         self.labels.taken(formula.box())
-        diff = (mb_lever - mb_poly) / abs(mb_poly) * 100.0 if mb_poly != 0 else 0.0
-        header = ["balancing moment Mb", "Mb, N·m", "difference, %"]
-        rows = [["by the force polygons", num(mb_poly), ""],
-                ["by Zhukovsky's lever", num(mb_lever), num(round(diff, 3)) if abs(diff) >= 1e-3 else "0.000"]]
-        height = self._fitting_height(header, rows, x1 - x0)
+        header, rows = self._mb_rows(mb_poly, mb_lever)
         mb = table(d, (x0, formula.box()[1] - 3), header, rows, _widths(header, rows, height), height=height,
                    name="balancing moment")
-        sc = scales_table(d, (x0, mb[1] - 4), height=height)
-        notes = ["Arrows on the lever show the lines and senses of the forces, not to scale: its table gives "
-                 "the values; the polygons are drawn at μ_F."] + self.sheet.notes
-        text = "\n".join(wrapped(f"{k + 1}. {line}", 0.7 * WIDTH_MARGIN * 3.0, x1 - x0)
-                         for k, line in enumerate(notes))
-        note = d.add(Text((x0, sc[1] - 3), "Notes:\n" + text, height=3.0, anchor=("left", "top")))
+        scales_table(d, (max(mb[2], formula.box()[2]) + self._gap() / 2, top), height=height)
+        note = d.add(Text(notes_at, self._notes_text(self.sheet.notes, width), height=self.s.text,
+                          anchor=("left", "top")))
         self.labels.taken(note.box())
+
+    def _lever_notes(self, mu_v: float) -> list[str]:
+        """The note μ_v ((m/s)/mm) calls for: the lever small."""
+        longest = self._lever_longest() / mu_v
+        return ([f"the lever is small at μ_v = {num(mu_v)} (m/s)/mm: its longest vector is {longest:.0f} mm"]
+                if longest < LEVER_MM * self.k else [])
 
     # -- Zhukovsky's lever -----------------------------------------------------------------------
     def _lever_longest(self) -> float:
@@ -629,7 +708,7 @@ class _Composer:
         v = self.plans.velocity.images
         pts = np.array([np.zeros(2)] + [[q[self.i, 1], -q[self.i, 0]] for q in v.values()])
         span = np.ptp(pts, axis=0)
-        room = _room(box, GROUP_MARGIN)
+        room = _room(box, self.margin, self.title_room)
         return nice_scale(max(span[0] / room[0], span[1] / room[1]))
 
     def _lever(self, box) -> None:
@@ -641,14 +720,10 @@ class _Composer:
         turned[POLE] = np.zeros(2)
         pts = np.array(list(turned.values()))
         self.mu_v = self.sheet.mu_v = mu_v = self._lever_scale(box)
-        longest = self._lever_longest()
-        if longest / mu_v < LEVER_MM:
-            self.sheet.notes.append(f"the lever is small at μ_v = {num(mu_v)} (m/s)/mm: its longest vector is "
-                                    f"{longest / mu_v:.0f} mm")
         self._title(box, "Zhukovsky's lever: the velocity plan turned 90° clockwise",
                     f"μ_v = {num(mu_v)} (m/s)/mm; the forces at the images of their points, not to scale")
         centre_q = (pts.min(axis=0) + pts.max(axis=0)) / 2
-        view = d.view(Scale("μ_v", mu_v, "(m/s)/mm"), origin=((x0 + x1) / 2, (y0 + y1 - TITLE_ROOM) / 2),
+        view = d.view(Scale("μ_v", mu_v, "(m/s)/mm"), origin=((x0 + x1) / 2, (y0 + y1 - self.title_room) / 2),
                       at=tuple(centre_q)).paper
         frame_points = {q for q in plans.velocity.images if q in self.mech.point_names
                         and self.mech.point_link(q) == self.mech.frame}
@@ -672,16 +747,16 @@ class _Composer:
             if size <= 1e-9 * largest:
                 continue
             start = np.array(view(turned[f.point]))
-            end = start + _arrow_mm(size, largest) * unit(f.force[i])
+            end = start + _arrow_mm(size, largest, self.k) * unit(f.force[i])
             d.add(Arrow(tuple(start), tuple(end), layer="forces", width=0.5, head=3.5))
             self.labels.mark([start, end])
             arrows.append((end, name(f.label), unit(f.force[i])))
-        self.labels.add(p, "p", box, height=LABEL, prefer=(-1, -1), gap=1.5)
+        self.labels.add(p, "p", box, height=self.s.text, prefer=(-1, -1), gap=1.5)
         for label, q in turned.items():
             if label == POLE or label in frame_points or np.hypot(*q) / mu_v < 0.5:
                 continue
             at = view(q)
             d.add(Circle(at, 0.8, layer="plans", filled=True))
-            self.labels.add(at, image(label), box, height=LABEL, prefer=(1, 1), gap=1.5)
+            self.labels.add(at, image(label), box, height=self.s.text, prefer=(1, 1), gap=1.5)
         for end, label, direction in arrows:
-            self.labels.add(end, label, box, height=LABEL, prefer=direction)
+            self.labels.add(end, label, box, height=self.s.text, prefer=direction)
