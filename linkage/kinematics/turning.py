@@ -253,6 +253,13 @@ def _crank(mech: Mechanism, structure: Structure, group: Group) -> str | None:
     return other if isinstance(joint, RevoluteJoint) else None
 
 
+def _dyad_pairs(group: Group) -> tuple | None:
+    """A dyad's pairs ``(external, inner, external)``, None for a group that is not a dyad: the
+    loops below are told by their pairs' kinds, never by the group solver's name."""
+    pairs = tuple(getattr(group, name, None) for name in ("ext1", "inner", "ext2"))
+    return None if any(p is None for p in pairs) else pairs
+
+
 def _point(joint, link: str) -> np.ndarray | None:
     """``joint``'s local point on ``link`` (m, ``(2,)``), None when not one point (a batch)."""
     p = np.asarray(joint.local(link)[0], dtype=float)
@@ -272,10 +279,11 @@ def _four_bar(mech: Mechanism, structure: Structure, group: Group, crank: str) -
     """The Grashof condition of the loop frame - crank - RRR dyad, when the crank does not turn by
     it: s + l > p + q (no link turns fully), or a Grashof chain whose shortest link is neither the
     crank nor the frame."""
-    if group.kind != "RRR":
-        return None
+    pairs = _dyad_pairs(group)
+    if pairs is None or not all(isinstance(j, RevoluteJoint) for j in pairs):
+        return None     # not a loop of four revolute pairs
     pivot = structure.input_joints[crank]
-    ext1, inner, ext2 = group.ext1, group.inner, group.ext2
+    ext1, inner, ext2 = pairs
     on_crank = [j for j in (ext1, ext2) if crank in (j.a, j.b)]
     on_frame = [j for j in (ext1, ext2) if mech.frame in (j.a, j.b)]
     if len(on_crank) != 1 or len(on_frame) != 1:
@@ -314,11 +322,13 @@ def _slider_crank(mech: Mechanism, structure: Structure, group: Group, crank: st
     """The rod against crank plus offset of an RRP dyad on the crank and a guide of the frame: B
     slides on a fixed line, A turns on a circle of radius r about O at the offset e from that line,
     and the rod AB = l reaches the line at every angle only when r + |e| <= l."""
-    if group.kind != "RRP":
+    pairs = _dyad_pairs(group)
+    if pairs is None:
         return None
     pivot = structure.input_joints[crank]
-    pin, inner, guide = group.ext1, group.inner, group.ext2
-    if crank not in (pin.a, pin.b) or not isinstance(guide, PrismaticJoint) or guide.a != mech.frame:
+    pin, inner, guide = pairs
+    if (crank not in (pin.a, pin.b) or not isinstance(pin, RevoluteJoint) or not isinstance(inner, RevoluteJoint)
+            or not isinstance(guide, PrismaticJoint) or guide.a != mech.frame):
         return None
     rod, slider = group.links if group.links[0] in (pin.a, pin.b) else group.links[::-1]
     r, l = _distance(pivot, pin, crank), _distance(pin, inner, rod)
