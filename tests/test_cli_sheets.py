@@ -42,7 +42,11 @@ def test_the_course_press_gets_its_three_sheets_numbered(linkage_run):
         head = (run.cwd / "s" / name).read_text(encoding="utf-8")[:2000]
         assert 'width="841' in head and 'height="594' in head and "mm" in head
     drawings, notes = project_sheets(linkage.load("course_slider_crank"))
-    assert [name for name, _ in drawings] == ["kinematics", "kinetostatics", "dynamics"] and not notes
+    assert [name for name, _ in drawings] == ["kinematics", "kinetostatics", "dynamics"]
+    scales = {**drawings[1][1].scales, **drawings[0][1].scales}
+    assert notes == [f"the plans and polygons apart at the sheets' scales: linkage plans course_slider_crank "
+                     f"--position 3 --mu-v {scales['μ_v'].value:g} --mu-a {scales['μ_a'].value:g} "
+                     f"--mu-f {scales['μ_F'].value:g}"]
     for k, (_, drawing) in enumerate(drawings, start=1):
         texts = " ".join(item.text for item in drawing.items if isinstance(item, Text))
         assert f"{k} of 3" in texts.replace("Sheet", "sheet")

@@ -98,6 +98,8 @@ def test_plan_vectors_times_scale_are_those_of_linkage_plans(sheets, linkage_run
             assert error < 0.005, (quantity, v["from"], v["to"], error)
             longest = max(longest, v["magnitude"] / mu)
         assert 30.0 <= longest <= 120.0        # readable: the longest vector between 30 (small box) and 120 mm
+        # one scale per quantity, shared by every file that draws it: the separate plan's own
+        assert mu == doc["scales"][quantity], (quantity, mu, doc["scales"][quantity])
 
 
 @pytest.mark.parametrize("name", SCHEMES)

@@ -19,7 +19,8 @@ import numpy as np
 from ...kinetostatics.plans import POLE, Plan
 from ...report.drawing import Scene, rail_hatch, support
 from .frame import WIDTH_MARGIN
-from .model import STANDARD_MANTISSAS, Arrow, Circle, Drawing, Line, Text
+from ...report.plan_drawings import nice_scale
+from .model import Arrow, Circle, Drawing, Line, Text
 
 __all__ = ["Sketch", "fitting_scale", "LabelPlacer", "draw_scene", "scene_points", "plan_extent",
            "draw_plan", "draw_diagram", "image_name", "vector_name", "SUBSCRIPT"]
@@ -31,18 +32,10 @@ CLEAR = 0.6
 
 
 def fitting_scale(span: float, room_mm: float) -> float:
-    """The smallest standard scale (1, 2, 2.5, 4, 5 x 10^n units per mm) that draws ``span``
-    (> 0) within ``room_mm`` mm: the largest drawing that fits."""
-    if not (math.isfinite(span) and span > 0):
-        return 1.0
-    need = span / room_mm
-    exponent = math.floor(math.log10(need))
-    for e in (exponent, exponent + 1):
-        for m in STANDARD_MANTISSAS:
-            value = float(f"{m * 10.0 ** e:.12g}")
-            if value >= need * (1 - 1e-12):
-                return value
-    return float(f"{10.0 ** (exponent + 2):.12g}")
+    """The smallest students' scale (1, 2, 2.5, 4, 5 x 10^n units per mm) that draws ``span``
+    (> 0) within ``room_mm`` mm: the largest drawing that fits (1.0 for a span that is not
+    positive and finite)."""
+    return nice_scale(span / room_mm) if math.isfinite(span) and span > 0 else 1.0
 
 
 @dataclass

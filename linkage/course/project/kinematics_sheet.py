@@ -10,8 +10,9 @@
   the output point), the chosen position thick, the output's extreme positions dashed, the
   trajectories of the output point and of the points the report's films trace;
 - right of it, the plans of velocities and accelerations at the chosen position
-  (:func:`linkage.kinetostatics.plans.build_plans`, the vectors of ``linkage plans``) at μ_v
-  and μ_a chosen so that the longest vector is 60–120 mm (smaller when the box is small);
+  (:func:`linkage.kinetostatics.plans.build_plans`, the vectors of ``linkage plans``) at the μ_v
+  and μ_a ``linkage plans`` draws them at (the longest vector 60–120 mm), coarser only where
+  the box is too small, with a note;
 - along the bottom, the diagrams of the output and its analogs over ψ, the angle turned from
   position 1 in the direction of rotation (per m of the input's slide for a slide input),
   d/dψ as in the tables (docs/conventions.md);
@@ -35,6 +36,7 @@ from ...kinematics.motion import analyze
 from ...model.mechanism import Mechanism, Prismatic
 from ...report.animation import default_trajectories
 from ...report.drawing import Geometry
+from ...report.plan_drawings import drawing_scales
 from ...report.results import analog_direction
 from ...structure import mobility, structure_of
 from .frame import WIDTH_MARGIN, TitleInfo, blank_sheet, scales_table, table
@@ -61,7 +63,7 @@ from .kinematics_strokes import (
     stroke_arrows,
     stroke_senses,
 )
-from .model import Drawing, Line, Scale, Text, standard_scale
+from .model import Drawing, Line, Scale, Text
 
 __all__ = ["kinematics_sheet", "SHEET_NAME"]
 
@@ -435,17 +437,20 @@ def _plans(drawing: Drawing, data: KinematicsData, boxes: dict, h: float) -> dic
                     "of the analogs per m of the slide below and `linkage analyze`."], h)
         return None
     scales = {}
+    students_scales = drawing_scales(data.plans, 0)
     for quantity, symbol, unit, pole in (("velocity", "μ_v", "(m/s)/mm", "p"),
                                          ("acceleration", "μ_a", "(m/s²)/mm", "π")):
         box = boxes[f"{quantity} plan"]
         drawing.region(f"{quantity} plan", box)
         plan = getattr(data.plans, quantity)
-        lo, hi, longest = plan_extent(plan, 0)
+        lo, hi, _ = plan_extent(plan, 0)
         x0, y0, x1, y1 = box
         room = (x1 - x0 - 8 * h, y1 - y0 - heading_height(h) - 8 * h)
-        k = min(1.0, room[1] / 130.0, room[0] / 130.0)
-        mu = standard_scale(longest, 60.0 * min(k, 1.0), 120.0 * min(k, 1.0)) if longest > 0 else 1.0
-        mu = max(mu, fitting_scale(hi[0] - lo[0], room[0]), fitting_scale(hi[1] - lo[1], room[1]))
+        shared = students_scales[quantity]
+        mu = max(shared, fitting_scale(hi[0] - lo[0], room[0]), fitting_scale(hi[1] - lo[1], room[1]))
+        if mu != shared:
+            data.notes.append(f"the {quantity} plan is drawn at {symbol} = {mu:g} {unit}, coarser than the "
+                              f"{shared:g} of `linkage plans` (its longest vector 60-120 mm), to fit the sheet")
         scale = Scale(symbol, mu, unit)
         plural = "velocities" if quantity == "velocity" else "accelerations"
         _heading(drawing, box, f"Plan of {plural}, position {data.index + 1}: {scale}", h)

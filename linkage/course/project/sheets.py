@@ -106,7 +106,22 @@ def project_sheets(mech: Mechanism, position: int | None = None, paper: str = "A
             notes.append(f"the {name} sheet is left out: {exc}")
             continue
         made.append((name, drawing))
+    notes += _plans_command(mech, position, dict(made), omega)
     return made, notes
+
+
+def _plans_command(mech: Mechanism, position: int, made: dict, omega: float | None) -> list[str]:
+    """The note giving the ``linkage plans`` command that draws the sheets' plans and polygons
+    apart at the sheets' own scales (one scale per quantity, shared by every file that draws it)."""
+    scales = {**(made["kinetostatics"].scales if "kinetostatics" in made else {}),
+              **(made["kinematics"].scales if "kinematics" in made else {})}
+    options = [f"{option} {scales[symbol].value:g}" for option, symbol in
+               (("--mu-v", "μ_v"), ("--mu-a", "μ_a"), ("--mu-f", "μ_F")) if symbol in scales]
+    if not options:
+        return []
+    speed = f" --omega {omega:g}" if omega is not None else ""
+    return [f"the plans and polygons apart at the sheets' scales: linkage plans {mech.name} --position {position}"
+            f"{speed} {' '.join(options)}"]
 
 
 def write_project_sheets(mech: Mechanism, out: str | Path, position: int | None = None, formats: Sequence[str] = ("pdf", "dxf"),
