@@ -180,6 +180,26 @@ def test_the_useful_resistance_diagram_of_a_stroke_diagram(sheets):
     np.testing.assert_allclose(sorted(zip(s, p)), expected, atol=1e-9 * max(force.values))
 
 
+def test_the_useful_resistance_of_a_cycle_table_rises_towards_the_end_of_the_working_stroke(sheets):
+    """The course press resists its slider's motion towards +x (the scheme's comment), most at the
+    end of that stroke: the drawn points are s = B.x - min B.x of the positions moving to +x and the
+    table's values, so 125 kN stands at s = H, not at the stroke's start."""
+    mech = linkage.load("course_slider_crank")
+    law = course_method(mech)
+    r, rod, offset = 0.0742, 0.2225, 0.01335                  # the scheme's crank, rod and guide's offset
+    x = r * np.cos(law.phi) + np.sqrt(rod**2 - (offset - r * np.sin(law.phi)) ** 2)
+    values = np.abs(np.array([0, 0, 0, 0, 0, 0, 0, 0, 0, 0, -12321, -27142, -125000], float))
+    drawing = sheets["course_slider_crank"]
+    dots = curve_points(drawing, "useful resistance")
+    s = (dots[:, 0] - dots[:, 0].min()) * drawing.scales["μ_s"].value
+    p = (dots[:, 1] - dots[:, 1].min()) * drawing.scales["μ_P"].value
+    stroke = x.max() - x.min()
+    towards_plus = np.r_[x[1:] - x[:-1], 1.0] > 0          # the positions 7..13 run to +x, 13 ends it
+    expected = sorted(zip(x[towards_plus] - x.min(), values[towards_plus]))
+    np.testing.assert_allclose(sorted(zip(s, p)), expected, atol=2e-4 * stroke + 1e-9 * 125000)
+    assert s[np.argmax(p)] == pytest.approx(stroke, rel=1e-6)
+
+
 @pytest.mark.parametrize("name", SHIPPED_WITH_DYNAMICS + TEMPLATES)
 def test_nothing_overlaps(sheets, name):
     assert layout_problems(sheets[name]) == []

@@ -42,6 +42,8 @@ from .flywheel import (
     wittenbauer_tangents,
 )
 from .frame import TitleInfo, blank_sheet, scales_table, table
+from ...report.plan_drawings import nice_scale
+from .kinematics_parts import fitting_scale
 from .model import Arrow, Circle, Drawing, Line, Scale, Text, standard_scale
 
 __all__ = ["dynamics_sheet", "useful_resistance"]
@@ -181,22 +183,22 @@ def _choose_scales(drawing: Drawing, data: _SheetData, layout: _Layout) -> _Scal
     plot_w = (x1 - x0) - 45
     s = _Scales()
     s["psi"] = drawing.use(Scale("μ_ψ", standard_scale(2 * np.pi, 0.7 * plot_w, plot_w), "rad/mm"))
-    s["M"] = drawing.use(Scale("μ_M", _fit(_span(data.moment, data.driving, 0.0), heights[0]), "(N·m)/mm"))
-    s["A"] = drawing.use(Scale("μ_A", _fit(_span(data.work_resistance, data.work_driving, 0.0), heights[1]),
+    s["M"] = drawing.use(Scale("μ_M", fitting_scale(_span(data.moment, data.driving, 0.0), heights[0]), "(N·m)/mm"))
+    s["A"] = drawing.use(Scale("μ_A", fitting_scale(_span(data.work_resistance, data.work_driving, 0.0), heights[1]),
                                "J/mm"))
     t = data.tangents
     wx0, wy0, wx1, wy1 = layout.witt
     witt_h = (wy1 - wy0) - 30 - WITT_WORDS * 1.6 * 0.8 * layout.text
-    energy_diag = _fit(_span(data.energy, 0.0), heights[2])
-    energy_witt = _fit(_span(data.energy, 0.0, t.intercept_upper, t.intercept_lower), witt_h)
+    energy_diag = fitting_scale(_span(data.energy, 0.0), heights[2])
+    energy_witt = fitting_scale(_span(data.energy, 0.0, t.intercept_upper, t.intercept_lower), witt_h)
     s["T"] = drawing.use(Scale("μ_T", max(energy_diag, energy_witt), "J/mm"))
-    s["I"] = drawing.use(Scale("μ_I", _fit(_span(data.inertia_variable, 0.0), min(heights[3], (wx1 - wx0) - 90)),
+    s["I"] = drawing.use(Scale("μ_I", fitting_scale(_span(data.inertia_variable, 0.0), min(heights[3], (wx1 - wx0) - 90)),
                                "(kg·m²)/mm"))
     swing = float(np.ptp(data.omega)) or 0.01 * data.mean_speed
-    mu_omega = _fit(swing, 0.8 * heights[4])
+    mu_omega = fitting_scale(swing, 0.8 * heights[4])
     top = max(float(np.max(data.omega)), data.mean_speed)
     while (top - _omega_axis(data, mu_omega)) / mu_omega > heights[4] + 1e-9:   # the axis' round value too
-        mu_omega = _coarser(mu_omega)
+        mu_omega = nice_scale(mu_omega * (1 + 1e-6))
     s["omega"] = drawing.use(Scale("μ_ω", mu_omega, "(rad/s)/mm"))
     return s
 
@@ -210,25 +212,6 @@ def _omega_axis(data: _SheetData, mu_omega: float) -> float:
 def _span(*values) -> float:
     arr = np.concatenate([np.atleast_1d(np.asarray(v, float)) for v in values])
     return float(np.ptp(arr)) or 1.0
-
-
-def _fit(span: float, room: float) -> float:
-    """The standard scale that draws ``span`` in at most ``room`` mm (and at least half of it)."""
-    scale = standard_scale(span, 0.5 * room, room)
-    while span / scale > room + 1e-9:
-        scale = _coarser(scale)
-    return scale
-
-
-def _coarser(scale: float) -> float:
-    """The next standard scale above ``scale``."""
-    exponent = math.floor(math.log10(scale))
-    for e in (exponent, exponent + 1):
-        for m in (1.0, 2.0, 2.5, 4.0, 5.0):
-            candidate = float(f"{m * 10.0 ** e:.12g}")
-            if candidate > scale * (1 + 1e-9):
-                return candidate
-    return scale * 10
 
 
 # ----------------------------------------------------------------------------------------------
@@ -528,7 +511,13 @@ def useful_resistance(mech: Mechanism, phi=None) -> list[dict]:
             peak = int(np.argmax(mag))
             moving = np.sign(first * load.rotation)
             at_end = np.abs(first) <= 1e-9 * stroke
-            working = (moving[peak] if not at_end[peak] else -moving[peak - 1 if peak else 1]) or 1.0
+            if at_end[peak]:        # at a stroke's end: the stroke on the side where the load is larger
+                n = len(mag)
+                before, after = (peak - 1) if peak else n - 2, (peak + 1) if peak < n - 1 else 1
+                working = moving[before] if mag[before] >= mag[after] else moving[after]
+            else:
+                working = moving[peak]
+            working = working or 1.0
             start = ext.value_min if working > 0 else ext.value_max
             s = np.abs(value - start)
             p = mag
@@ -553,9 +542,9 @@ def _resistance_panel(drawing: Drawing, mech: Mechanism, data: _SheetData, box, 
     stroke = max(d["stroke"] for d in diagrams)
     peak = max(float(np.max(d["P"])) for d in diagrams) or 1.0
     unit = "rad" if diagrams[0]["quantity"].endswith(".theta") else "m"
-    ox, oy = x0 + 30.0, y0 + 4 * h
-    mu_s = drawing.use(Scale("μ_s", _fit(stroke, (x1 - x0) - 60), f"{unit}/mm"))
-    mu_p = drawing.use(Scale("μ_P", _fit(peak, (y1 - y0) - 8 * h - 12), "N/mm"))
+    ox, oy = x0 + 7 * h + 4.0, y0 + 4 * h               # room left of the P axis for its values
+    mu_s = drawing.use(Scale("μ_s", fitting_scale(stroke, x1 - ox - 3 * h - 12.0), f"{unit}/mm"))
+    mu_p = drawing.use(Scale("μ_P", fitting_scale(peak, (y1 - y0) - 8 * h - 12), "N/mm"))
     view = drawing.view(mu_s, origin=(ox, oy), scale_y=mu_p)
     end = ox + stroke / mu_s.value
     top = oy + peak / mu_p.value
@@ -565,7 +554,12 @@ def _resistance_panel(drawing: Drawing, mech: Mechanism, data: _SheetData, box, 
     drawing.add(Text((ox + 2, top + 8), "P, N", height=h, anchor=("left", "top")))
     _value_ticks(drawing, ox, oy, 0.0, 0.0, peak, mu_p.value, _small(h, 0.8))
     view.line([(stroke, 0.0), (stroke, peak * 0.15)], layer="dimensions", width=0.18)
-    drawing.add(Text((end, oy - 1.5), f"H = {_num(stroke)} {unit}", height=_small(h, 0.8), anchor=("right", "top")))
+    stroke_label = Text(((ox + end) / 2, oy - 1.5), f"H = {_num(stroke)} {unit}", height=_small(h, 0.8),
+                        anchor=("center", "top"))
+    if stroke_label.box()[0] < ox + 1.0:                # wider than the stroke: from the P axis on
+        stroke_label = Text((ox + 1.0, oy - 1.5), stroke_label.text, height=stroke_label.height,
+                            anchor=("left", "top"))
+    drawing.add(stroke_label)
     for d in diagrams:
         s, p, idle = d["s"], d["P"], d["idle"]
         work = np.column_stack([s[~idle], p[~idle]])
@@ -633,7 +627,7 @@ def _flywheel_panel(drawing: Drawing, data: _SheetData, rim, box, h: float, hd: 
     axis_end = half_b + rim.width * 0.6
     view.line([(-axis_end, 0.0), (axis_end, 0.0)], layer="dimensions", width=0.25, dashed=True)
     view.text((axis_end, 0.0), "shaft axis", offset=(1.0, 0.0), height=_small(h, 0.7), anchor=("left", "middle"))
-    view.line([(-axis_end, r), (axis_end, r)], layer="dimensions", width=0.18, dashed=True)
+    view.line([(-half_b - rim.width * 0.1, r), (axis_end, r)], layer="dimensions", width=0.18, dashed=True)
     # dimensions: D/2 (the mean radius) on the right, h on the left, b above
     xr = half_b + rim.width * 0.3
     _dimension(view, (xr, 0.0), (xr, r), f"D/2 = {rim.diameter / 2:.3f} m", _small(h, 0.7), side="right")
@@ -645,7 +639,7 @@ def _flywheel_panel(drawing: Drawing, data: _SheetData, rim, box, h: float, hd: 
 
 def _fit_pair(height_m: float, room_h: float, width_m: float, room_w: float) -> float:
     """The finest standard scale drawing ``height_m`` in ``room_h`` mm and ``width_m`` in ``room_w``."""
-    return max(_fit(height_m, room_h), _fit(width_m, room_w))
+    return max(fitting_scale(height_m, room_h), fitting_scale(width_m, room_w))
 
 
 def _hatch(drawing: Drawing, corners, spacing: float) -> None:
