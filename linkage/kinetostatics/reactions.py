@@ -33,6 +33,7 @@ from assur.rows import rows_of
 from ..errors import InputError
 from ..kinematics.inputs import input_angles
 from ..kinematics.motion import Motion, angle_in_half_turn
+from .friction import Friction, friction_angle_deg, friction_of, friction_terms, group_with_friction
 from .loads import Loads, LoadTerm, evaluate_loads, generalized_loads, inertia_terms, loads_of
 
 __all__ = ["Reactions", "reactions_under", "solve_reactions", "virtual_power_residual"]
@@ -54,6 +55,15 @@ class Reactions:
     terms : list of LoadTerm
         The applied and inertia loads used.
     notes : tuple of str
+    friction : Friction or None
+        The pairs' friction the reactions include (None: frictionless); their loads are the
+        ``terms`` of kind ``"friction"`` (label: the pair).
+    sense : float
+        The sense of motion of a static analysis (no ``motion.omega``): +1 the input's coordinate
+        increasing, -1 decreasing; the friction opposes it and the powers are per unit of speed.
+    locked, locked_pair : ndarray (N,) of bool and of str, or None
+        With friction: the positions where no finite balancing load moves the mechanism
+        (self-locking; every value NaN there) and the pair whose friction locks it.
     balancing_moments : dict of input link -> ndarray (N,)
         The balancing moment of every input link, N m (CCW positive), or force, N, for a slide
         input: with several inputs (:class:`~linkage.model.input_laws.InputLaw`), each motor's share; the
@@ -67,6 +77,10 @@ class Reactions:
     terms: list[LoadTerm]
     notes: tuple[str, ...] = ()
     balancing_moments: dict[str, np.ndarray] = field(default_factory=dict)
+    friction: Friction | None = None
+    locked: np.ndarray | None = None
+    locked_pair: np.ndarray | None = None
+    sense: float = 1.0
 
     def force(self, pair: str) -> np.ndarray:
         """``R[a, b]`` ``(N, 2)`` for the pair declared with ``links = [a, b]``, N."""
@@ -102,6 +116,69 @@ class Reactions:
         f = self.force(pair)
         return np.degrees(angle_in_half_turn(np.arctan2(f[:, 1], f[:, 0])))
 
+    # -- friction, powers and efficiency ------------------------------------------------------
+
+    def speed(self) -> np.ndarray:
+        """The input's speed the powers are at (N,): ``motion.omega`` (rad/s; m/s for a slide
+        input), or, for a static analysis, the sense of motion the friction opposed (+1 or -1,
+        so the powers are per unit of speed)."""
+        if self.motion.omega is not None:
+            return np.asarray(self.motion.omega, float)
+        return np.full(len(self.motion.phi), self.sense)
+
+    def term_power(self, term: LoadTerm) -> np.ndarray:
+        """The power of one load term (N,), W: ``(F·r'_P + M·θ')·ω``."""
+        v, _ = point_analogs(self.motion.poses[term.link], self.motion.first[term.link], None, term.local)
+        analog = np.einsum("ni,ni->n", term.force, v) + term.moment * self.motion.first[term.link][:, 2]
+        return analog * self.speed()
+
+    def friction_load(self, pair: str) -> np.ndarray:
+        """The friction in ``pair`` (N,): for a revolute pair the moment on its first link (N m),
+        for a prismatic pair the force on the slider along the guide's direction (N); 0 without
+        friction in the pair."""
+        if pair not in self.motion.mechanism.pairs:
+            raise InputError(f"mechanism '{self.motion.mechanism.name}' has no pair '{pair}'")
+        joint = self.motion.joints[pair]
+        on_first = [t for t in self.terms if t.kind == "friction" and t.label == pair]
+        if not on_first:
+            return np.zeros(len(self.motion.phi))
+        if isinstance(joint, PrismaticJoint):
+            u, *_ = joint.frame(self.motion.poses)
+            slider = next(t for t in on_first if t.link == joint.b)
+            return np.einsum("ni,ni->n", slider.force, u)
+        return next(t for t in on_first if t.link == joint.a).moment
+
+    def friction_power(self, pair: str | None = None) -> np.ndarray:
+        """The power friction takes in ``pair`` (every pair's sum by default), W, <= 0 (N,)."""
+        return sum((self.term_power(t) for t in self.terms if t.kind == "friction"
+                    and (pair is None or t.label == pair)), np.zeros(len(self.motion.phi)))
+
+    def powers(self) -> dict[str, np.ndarray]:
+        """The powers at every position (N,), W: ``driving`` (the balancing load's, with the loads
+        declared as driving), ``useful`` (the resisting external loads', <= 0 where they resist),
+        ``gravity``, ``inertia`` and ``friction`` (<= 0). Their sum is 0 (virtual power)."""
+        n = len(self.motion.phi)
+        out = {k: np.zeros(n) for k in ("driving", "useful", "gravity", "inertia", "friction")}
+        rates = input_angles(self.motion.mechanism, self.motion.structure, self.motion.phi)
+        speed = self.speed()
+        out["driving"] = out["driving"] + self.balancing_moment * speed
+        for link in self.motion.structure.inputs[1:]:
+            out["driving"] = out["driving"] + self.balancing_moments[link] * rates[link][1] * speed
+        kinds = {"driving": "driving", "external": "useful", "gravity": "gravity", "inertia": "inertia",
+                 "friction": "friction"}
+        for t in self.terms:
+            out[kinds.get(t.kind, "useful")] = out[kinds.get(t.kind, "useful")] + self.term_power(t)
+        return out
+
+    def efficiency(self) -> np.ndarray:
+        """Instantaneous efficiency ``η = −P_useful / P_driving`` (N,): NaN where the drive
+        delivers no power (P_driving <= 0: the mechanism is driven by its inertia, gravity or a
+        load there) and where the reactions are NaN."""
+        p = self.powers()
+        driving = p["driving"]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.where(driving > 0, 0.0 - p["useful"] / np.where(driving > 0, driving, 1.0), np.nan) + 0.0
+
     def columns(self, full: bool = False, direction: int | None = None) -> dict[str, np.ndarray]:
         """Table: ``i``, ``phi_deg`` (as in :meth:`Motion.columns`; ``s`` for a slide input),
         ``balancing_moment`` (N m; ``balancing_force``, N, for a slide input; with several inputs,
@@ -109,7 +186,10 @@ class Reactions:
         pair ``K.R`` (magnitude of ``R[a, b]``, N) and ``K.angle_deg`` (its direction, deg CCW
         from +x in (-180, 180]); with ``full`` also ``K.Rx``, ``K.Ry`` (N) and, for
         prismatic pairs, ``K.M`` (N m, the moment of the slider on the guide about the slider's
-        point). Pairs in the order of their names. ``direction``: see :meth:`Motion.columns`."""
+        point). Pairs in the order of their names. ``direction``: see :meth:`Motion.columns`.
+        With friction: ``efficiency`` (η, :meth:`efficiency`), ``power_lost`` (W, every pair's
+        friction) and per pair with friction ``K.friction`` (:meth:`friction_load`: N m on the
+        pair's first link, or N on the slider along the guide) and ``K.power_lost`` (W, >= 0)."""
         cols = self.motion.position_columns(direction)
         load = self.motion.mechanism.coordinate.load
         cols[f"balancing_{load}"] = self.balancing_moment
@@ -118,6 +198,9 @@ class Reactions:
             kind = "moment" if mech.input_kind(declared) == "angle" else "force"
             missing = np.full(len(self.motion.phi), np.nan)
             cols[f"balancing_{kind}.{declared}"] = self.balancing_moments.get(link, missing)
+        if self.friction:
+            cols["efficiency"] = self.efficiency()
+            cols["power_lost"] = -self.friction_power()
         for name in sorted(self.multipliers):
             cols[f"{name}.R"] = self.magnitude(name)
             cols[f"{name}.angle_deg"] = self.direction_deg(name)
@@ -126,6 +209,9 @@ class Reactions:
                 cols[f"{name}.Rx"], cols[f"{name}.Ry"] = f[:, 0], f[:, 1]
                 if isinstance(self.motion.joints[name], PrismaticJoint):
                     cols[f"{name}.M"] = self.moment(name)
+            if self.friction and name in self.friction.pairs:
+                cols[f"{name}.friction"] = self.friction_load(name)
+                cols[f"{name}.power_lost"] = -self.friction_power(name)
         return cols
 
 
@@ -136,6 +222,8 @@ def solve_reactions(
     inertia: bool = True,
     ends: ArrayLike | None = None,
     pairs: Iterable[str] | None = None,
+    friction: Friction | bool | None = None,
+    sense: float | None = None,
 ) -> Reactions:
     """Reactions in every pair and the balancing moment, group by group from the farthest.
 
@@ -157,6 +245,13 @@ def solve_reactions(
         links' loads are evaluated; the motion needs only those links (``analyze(...,
         outputs=...)``). The balancing moment needs the input's pair; without it, it is NaN.
         Default: every pair and the balancing moment.
+    friction : Friction or bool, optional
+        Coulomb friction in the pairs (docs/methods.md#friction-in-the-pairs): ``True`` for the
+        scheme's ``[friction]`` (:func:`~linkage.kinetostatics.friction.friction_of`; an error
+        without one), or a :class:`~linkage.kinetostatics.friction.Friction`. Default: frictionless.
+    sense : {1, -1}, optional
+        The input's sense of motion the friction opposes where the motion has no speed (static
+        analysis): +1 its coordinate increasing (default), -1 decreasing. With a speed, its sign.
     """
     mech = motion.mechanism
     if motion.second is None:
@@ -168,7 +263,12 @@ def solve_reactions(
         terms += inertia_terms(motion, links)
     notes = loads.notes + (() if inertia and motion.omega is not None or not inertia else
                            ("no speed given: inertia loads are zero (static analysis)",))
-    return reactions_under(motion, terms, pairs, notes)
+    if friction is True:
+        friction = friction_of(mech)
+        if friction is None:
+            raise InputError(f"scheme '{mech.name}' declares no [friction]: add it (docs/friction.md), e.g. "
+                             "[friction] revolute = { f = 0.1, radius = 0.02 } and prismatic = { f = 0.15 }")
+    return reactions_under(motion, terms, pairs, notes, friction=friction or None, sense=sense)
 
 
 def _links_loaded(motion: Motion, pairs: Iterable[str] | None) -> set[str] | None:
@@ -192,13 +292,14 @@ def _links_loaded(motion: Motion, pairs: Iterable[str] | None) -> set[str] | Non
 
 
 def reactions_under(motion: Motion, terms: list[LoadTerm], pairs: Iterable[str] | None = None,
-                    notes: tuple[str, ...] = ()) -> Reactions:
+                    notes: tuple[str, ...] = (), *, friction: Friction | None = None,
+                    sense: float | None = None) -> Reactions:
     """Reactions and the balancing moment under load terms already evaluated at the motion's
     positions (:func:`solve_reactions` evaluates the mechanism's declared loads first; a
     batch of variants gives its own, :func:`linkage.kinetostatics.batch.variant_reactions`).
 
     ``terms`` must hold the loads on every link the reactions in ``pairs`` need (default: every
-    pair and the balancing moment).
+    pair and the balancing moment). ``friction`` and ``sense``: see :func:`solve_reactions`.
     """
     if motion.second is None:
         raise InputError("reactions need a motion analysed with order=2")
@@ -208,17 +309,37 @@ def reactions_under(motion: Motion, terms: list[LoadTerm], pairs: Iterable[str] 
     applied = generalized_loads(motion, terms)
     multipliers: dict[str, np.ndarray] = {}
     valid = motion.status == OK
+    n = len(motion.phi)
+    heading = _sense(motion, sense)
+    static = 1.0 if sense is None else float(sense)
+    locked_pair = np.full(n, "", dtype=object)
+    lost: list[LoadTerm] = []
     for i in reversed(group_ids):
         group = structure.groups[i]
         frames = {k: motion.frame(k) for k in (*group.links, *group.known_links)}
         lam, transmitted = group.reactions(motion.poses, applied, valid=valid, frames=frames)
+        if friction and any(k in friction.pairs for k in lam):
+            def solve(loaded, group=group, frames=frames):
+                return group.reactions(motion.poses, loaded, valid=valid, frames=frames)
+            solved = group_with_friction(motion, solve, applied, set(group.links), friction, heading, valid,
+                                         (lam, transmitted))
+            lam, transmitted = solved.multipliers, solved.transmitted
+            lost += solved.terms
+            locked_pair[solved.locked & (locked_pair == "")] = solved.worst
+            on_known = generalized_loads(motion, [t for t in solved.terms if t.link not in group.links])
+            for link in group.known_links:
+                if link in on_known:
+                    applied[link] = applied[link] + on_known[link]
         multipliers.update(lam)
         for link, load in transmitted.items():
             applied[link] = applied[link] + load
+    terms = terms + lost
     if not everything:
         notes = notes + ("balancing moment not computed: only the reactions in pairs "
                          f"{sorted(pairs)} were asked for",)
-        return Reactions(motion, multipliers, np.full(len(motion.phi), np.nan), terms, notes)
+        return Reactions(motion, multipliers, np.full(n, np.nan), terms, notes, friction=friction,
+                         locked=(locked_pair != "") if friction else None, locked_pair=locked_pair if friction else None,
+                         sense=static)
     balancing = {}
     for link in structure.inputs:
         # each input link's equilibrium: the drive takes the load's part along the link's motion
@@ -230,15 +351,59 @@ def reactions_under(motion: Motion, terms: list[LoadTerm], pairs: Iterable[str] 
             continue
         rows = rows_of(joint, {k: motion.frame(k) for k in (joint.a, joint.b)})
         motion_per_unit, drive = input_freedom(joint, link, rows)
-        load = -applied[link]
-        balancing[link] = sum(load[:, c] * motion_per_unit[c] for c in range(3))
-        rest = tuple(load[:, c] - balancing[link] * drive[c] for c in range(3))
-        multipliers[joint.name] = np.column_stack(rows.multipliers(link, rest))
-    bad = ~valid
+
+        def solve_input(loaded, link=link, rows=rows, motion_per_unit=motion_per_unit, drive=drive, joint=joint):
+            load = -loaded[link]
+            moment = sum(load[:, c] * motion_per_unit[c] for c in range(3))
+            rest = tuple(load[:, c] - moment * drive[c] for c in range(3))
+            return {joint.name: np.column_stack(rows.multipliers(link, rest))}, {"": moment}
+
+        lam, out = solve_input(applied)
+        if friction and joint.name in friction.pairs:
+            solved = group_with_friction(motion, solve_input, applied, {link}, friction, heading, valid, (lam, out))
+            lam, out = solved.multipliers, solved.transmitted
+            terms = terms + solved.terms
+            locked_pair[solved.locked & (locked_pair == "")] = solved.worst
+        balancing[link] = out[""]
+        multipliers.update(lam)
+    locked = locked_pair != ""
+    bad = ~valid | locked
     if bad.any():
         balancing = {k: np.where(bad, np.nan, v) for k, v in balancing.items()}
         multipliers = {k: np.where(bad[:, None], np.nan, v) for k, v in multipliers.items()}
-    return Reactions(motion, multipliers, balancing[structure.inputs[0]], terms, notes, balancing)
+    if friction and locked.any():
+        notes = notes + (_locked_note(motion, friction, locked, locked_pair),)
+    return Reactions(motion, multipliers, balancing[structure.inputs[0]], terms, notes, balancing, friction=friction,
+                     locked=locked if friction else None, locked_pair=locked_pair if friction else None,
+                     sense=static)
+
+
+def _sense(motion: Motion, sense: float | None) -> np.ndarray:
+    """The input's sense of motion per position (N,): the sign of its speed, else ``sense``
+    (default +1)."""
+    n = len(motion.phi)
+    if motion.omega is not None and np.any(motion.omega != 0):
+        return np.where(motion.omega != 0, np.sign(motion.omega), 1.0 if sense is None else float(np.sign(sense)))
+    if sense is not None and sense not in (1, -1):
+        raise InputError(f"sense must be +1 or -1 (the input's coordinate increasing or decreasing), got {sense!r}")
+    return np.full(n, 1.0 if sense is None else float(sense))
+
+
+def _locked_note(motion: Motion, friction: Friction, locked: np.ndarray, pair: np.ndarray) -> str:
+    """The note naming where the mechanism self-locks, the pair and its friction angle."""
+    where = np.flatnonzero(locked)
+    by_pair: dict[str, list[int]] = {}
+    for i in where:
+        by_pair.setdefault(str(pair[i]), []).append(int(i))
+    parts = []
+    for name, rows in by_pair.items():
+        f = friction.pairs[name].f if name in friction.pairs else float("nan")
+        shown = motion.mechanism.coordinate.describe(motion.phi[rows[:6]])
+        more = f" and {len(rows) - 6} more" if len(rows) > 6 else ""
+        parts.append(f"pair {name} (f = {f:g}, friction angle {friction_angle_deg(f):.2f} deg) at position(s) "
+                     f"{', '.join(str(r + 1) for r in rows[:6])}{more} ({shown})")
+    return ("self-locking: no finite balancing load moves the mechanism against its friction at "
+            + "; ".join(parts) + " -- the values there are NaN")
 
 
 def input_freedom(joint, link: str, rows) -> tuple[tuple, tuple]:
