@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+from dataclasses import replace
 
 import numpy as np
 
@@ -13,6 +14,7 @@ from ..dynamics.equation import StartupStall, simulate
 from ..dynamics.spec import override_spec
 from ..dynamics.stroke import stroke_motion
 from ..errors import InputError
+from ..kinetostatics.friction import friction_of
 from ..report.results import dynamics_results
 from .options import (
     CONVENTIONS,
@@ -71,6 +73,11 @@ def add(sub) -> None:
                         help="the actuator's force along +s, N (default 0: the declared loads alone)")
     stroke.add_argument("--initial-speed", metavar="M_S", type=real, default=None,
                         help="|ds/dt| at the start of the stroke, m/s (default 0: from rest)")
+    p.add_argument("--friction", action="store_true",
+                   help="Coulomb friction in the pairs, from the scheme's [friction] (docs/friction.md): its "
+                        "reduced moment at the mean speed (column reduced_moment_friction, N m) joins the "
+                        "resistance, so the driving moment, the flywheel and the motor account for it; the "
+                        "summary gains friction_work (J per cycle) and cycle_efficiency")
     add_columns_argument(p)
     add_format_argument(p)
     p.set_defaults(handler=run)
@@ -107,7 +114,7 @@ _SUMMARY_UNITS = {
     "driving_moment": "N m", "required_constant_inertia": "kg m^2", "flywheel_inertia": "kg m^2",
     "mean_speed_actual": "rad/s", "constant_inertia": "kg m^2",
     "exact_required_constant_inertia": "kg m^2", "exact_flywheel_inertia": "kg m^2",
-    "transient_time": "s", "settling_time": "s", "initial_speed": "rad/s",
+    "transient_time": "s", "settling_time": "s", "initial_speed": "rad/s", "friction_work": "J",
 }
 
 
@@ -136,6 +143,8 @@ def run(args: argparse.Namespace) -> int:
     if args.method == "ode":
         with _options_named(args):
             spec = override_spec(mech, None, args.delta, input_speed(args, mech), args.positions)
+            if args.friction:
+                spec = replace(spec, friction=friction_of(mech))
         if args.transient and spec.initial_speed is None:
             raise InputError(f"--transient: scheme '{mech.name}' declares no speed to start from: give "
                              "initial_rpm (or initial_speed, rad/s) in its [dynamics] section")
@@ -144,7 +153,7 @@ def run(args: argparse.Namespace) -> int:
         note("note", f"{first}shooting for the motor-driven steady state{then}; this takes a few seconds")
     with _options_named(args):
         results = dynamics_results(mech, args.method, positions=args.positions, delta=args.delta,
-                                   mean_speed=input_speed(args, mech))
+                                   mean_speed=input_speed(args, mech), friction=args.friction)
     report, summary = results.report, dict(results.summary)
     for line in report.notes:
         note("note", line)

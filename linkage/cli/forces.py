@@ -50,6 +50,13 @@ def add(sub) -> None:
                            "none: a static analysis)")
     p.add_argument("--eps", metavar="RAD_S2", type=real, default=0.0,
                    help="input angular acceleration, rad/s^2 (default 0); for a slide input, m/s^2")
+    p.add_argument("--friction", action="store_true",
+                   help="Coulomb friction in the pairs, from the scheme's [friction] (docs/friction.md): "
+                        "balancing_moment then holds the balancing moment with friction (same sign convention), "
+                        "and the table gains efficiency (useful over driving power), power_lost (W), per pair "
+                        "K.Mf (N m, revolute) or K.Ff (N, prismatic) and K.power_lost (W); the works and the "
+                        "efficiency of one turn at constant speed are printed below the table (JSON: cycle). "
+                        "Positions where the mechanism self-locks are NaN, with a note naming the pair")
     add_columns_argument(p)
     add_format_argument(p)
     p.set_defaults(handler=run)
@@ -59,17 +66,20 @@ def _forces_view(columns: dict) -> list[str]:
     """The default columns of ``linkage forces`` for people: the balancing moment, then the
     magnitude of every reaction, then their directions, as many as fit, in table order."""
     pairs = [name[:-2] for name in columns if name.endswith(".R")]
-    moments = [name for name in columns if name.startswith("balancing_")]
-    groups = [moments] + [[f"{k}.R"] for k in pairs] + [[f"{k}.angle_deg"] for k in pairs]
+    moments = [name for name in columns if name.startswith("balancing_") or name in ("efficiency", "power_lost")]
+    losses = [[name] for name in columns if name.endswith((".Mf", ".Ff"))]
+    groups = [moments] + [[f"{k}.R"] for k in pairs] + losses + [[f"{k}.angle_deg"] for k in pairs]
     shown = set(fit(columns, leading(columns), groups))
     return [name for name in columns if name in shown]
 
 
 def run(args: argparse.Namespace) -> int:
     mech = load_scheme(args)
-    results = forces_results(mech, args.positions, args.start, input_speed(args, mech), args.eps)
+    results = forces_results(mech, args.positions, args.start, input_speed(args, mech), args.eps,
+                             friction=args.friction)
     say(results)
     meta = results.meta
+    cycle = meta.get("cycle")
     if args.format == "table":
         omega, phi = meta["omega"], results.motion.phi
         direction = declared_rotation(mech) if not omega else int(np.sign(omega))
@@ -78,5 +88,13 @@ def run(args: argparse.Namespace) -> int:
         meta = {"scheme": mech.name, "start": start_line(mech, phi, meta["start"], meta["positions"], direction),
                 "omega": speed, "eps": f"{args.eps:.6g} {unit}/s^2", "convention": meta["convention"],
                 "virtual_power_residual_max": meta["virtual_power_residual_max"]}
+        if args.friction:
+            meta["friction"] = ", ".join(f"{k}: f = {v['f']:g}" + (f", r = {v['radius']:g} m" if "radius" in v else "")
+                                         + (f", block {v['length']:g} m" if "length" in v else "")
+                                         for k, v in results.meta["friction"].items()) or "none declared (f = 0)"
+            if cycle:
+                meta["cycle"] = (f"one turn at constant speed ({cycle['samples']} steps): driving work "
+                                 f"{cycle['driving_work']:.6g} {cycle['unit']}, useful {cycle['useful_work']:.6g}, "
+                                 f"friction {cycle['friction_work']:.6g}; efficiency {cycle['efficiency']:.4f}")
     emit(results.columns, args, meta, _forces_view)
     return 0

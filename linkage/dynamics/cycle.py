@@ -147,7 +147,8 @@ def course_method(mech: Mechanism, spec: DynamicsSpec | None = None, *, position
                                  "speed fluctuation): declare it in [dynamics] or pass delta=")
     phi, ends = cycle_positions(mech, spec)
     n = len(phi) - 1
-    red = reduced_characteristics(mech, phi, spec.rotation, extra_inertia=spec.constant_inertia, ends=ends)
+    red = reduced_characteristics(mech, phi, spec.rotation, extra_inertia=spec.constant_inertia, ends=ends,
+                                  friction=spec.friction, speed=spec.mean_speed)
     step = 2 * np.pi / n
     work = np.concatenate([[0.0], np.cumsum((red.moment[1:] + red.moment[:-1]) / 2 * step)])
     driving = -work[-1] / (2 * np.pi)
@@ -200,7 +201,8 @@ class _Cycle:
 def fine_cycle(mech: Mechanism, spec: DynamicsSpec, samples: int) -> _Cycle:
     n = spec.positions * max(1, math.ceil(samples / spec.positions))
     phi, ends = cycle_positions(mech, spec, n)
-    red = reduced_characteristics(mech, phi, spec.rotation, extra_inertia=spec.constant_inertia, ends=ends)
+    red = reduced_characteristics(mech, phi, spec.rotation, extra_inertia=spec.constant_inertia, ends=ends,
+                                  friction=spec.friction, speed=spec.mean_speed)
     psi = np.arange(n + 1) * 2 * np.pi / n
     work = np.concatenate([[0.0], np.cumsum((red.moment[1:] + red.moment[:-1]) / 2 * np.diff(psi))])
     driving = -work[-1] / (2 * np.pi)
@@ -329,4 +331,5 @@ def exact_method(mech: Mechanism, spec: DynamicsSpec | None = None, *, positions
 
 def reduced_at(red: Reduced, index) -> Reduced:
     return Reduced(red.phi[index], red.rotation, red.moment_resistance[index], red.moment_driving[index],
-                   red.inertia_constant, red.inertia_variable[index], red.inertia_derivative[index])
+                   red.inertia_constant, red.inertia_variable[index], red.inertia_derivative[index],
+                   None if red.moment_friction is None else red.moment_friction[index])

@@ -12,13 +12,14 @@ is a note saying where and why: the steady state stands without it).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
 
 from ..errors import DynamicsInputError
 from ..kinematics.motion import analyze, table_positions_deg
+from ..kinetostatics.friction import friction_of
 from ..kinetostatics.reactions import solve_reactions
 from ..model.mechanism import Mechanism
 from .cycle import (
@@ -68,12 +69,14 @@ class DynamicsReport:
         position's speed (ode) -- plus the loads declared as driving), ``reduced_inertia`` (kg m^2,
         the machine as declared: ``I_0 + I''``, without a flywheel the method adds),
         ``reduced_inertia_derivative`` (dI/dpsi, kg m^2/rad), ``omega`` (rad/s, signed), ``eps``
-        (rad/s^2), ``balancing_moment`` (N m, under that motion)."""
+        (rad/s^2), ``balancing_moment`` (N m, under that motion); with friction
+        ``reduced_moment_friction`` (N m, <= 0: the friction's part of M_c)."""
         red = self.law.reduced
         return {
             "i": np.arange(1, len(self.law.phi) + 1),
             "phi_deg": table_positions_deg(self.law.phi),
             "reduced_moment_resistance": red.moment_resistance,
+            **({} if red.moment_friction is None else {"reduced_moment_friction": red.moment_friction}),
             "reduced_moment_driving": red.moment_driving + self.law.driving,
             "reduced_inertia": red.inertia,
             "reduced_inertia_derivative": red.inertia_derivative,
@@ -81,6 +84,17 @@ class DynamicsReport:
             "eps": self.law.eps,
             "balancing_moment": self.balancing_moment,
         }
+
+    def _friction_summary(self) -> dict[str, float]:
+        """With friction: the work it takes per cycle (J, the trapezoid over the table positions, as
+        the course integrates A_c) and the cycle's efficiency ``1 − A_friction / A_driving``."""
+        red, law = self.law.reduced, self.law
+        if red.moment_friction is None:
+            return {}
+        psi = np.abs(law.phi - law.phi[0])
+        lost = -float(np.trapezoid(red.moment_friction, psi))
+        driving = float(np.trapezoid(red.moment_driving + law.driving, psi))
+        return {"friction_work": lost, "cycle_efficiency": 1 - lost / driving if driving > 0 else None}
 
     def summary(self) -> dict[str, Any]:
         """The scalar results (JSON keys of ``linkage dynamics``); ``dynamic_coefficient`` is None
@@ -95,13 +109,14 @@ class DynamicsReport:
             "mean_speed_actual": law.mean_speed_actual,
             "dynamic_coefficient": self.dynamic_coefficient,
             "constant_inertia": law.constant_inertia,
+            **self._friction_summary(),
             **self.comparison,
         }
 
 
 def run_dynamics(mech: Mechanism, method: str = "course", *, positions: int | None = None,
                  delta: float | None = None, mean_speed: float | None = None,
-                 compare: bool = True) -> DynamicsReport:
+                 compare: bool = True, friction: bool = False) -> DynamicsReport:
     """The whole pipeline: law of motion by ``method``, then kinetostatics under the real motion.
 
     Parameters
@@ -114,6 +129,10 @@ def run_dynamics(mech: Mechanism, method: str = "course", *, positions: int | No
     compare : bool
         Also run the exact method next to the course method and report how far apart they are
         (left out, with a note, when ``delta`` is below :data:`DELTA_RESOLVED`).
+    friction : bool
+        Friction in the pairs from the scheme's ``[friction]``: its reduced moment (at the mean
+        speed) joins the resistance of every method, so the flywheel and the motor account for it,
+        and the reactions under the real motion include it.
 
     Raises
     ------
@@ -126,6 +145,12 @@ def run_dynamics(mech: Mechanism, method: str = "course", *, positions: int | No
     if method not in ("course", "exact", "ode"):
         raise DynamicsInputError(f"method must be 'course', 'exact' or 'ode', got {method!r}")
     spec = override_spec(mech, None, delta, mean_speed, positions)
+    if friction:
+        declared = friction_of(mech)
+        if declared is None:
+            raise DynamicsInputError(f"scheme '{mech.name}' declares no [friction]: add it (docs/friction.md), e.g. "
+                                     "[friction] revolute = { f = 0.1, radius = 0.02 } and prismatic = { f = 0.15 }")
+        spec = replace(spec, friction=declared)
     comparison: dict[str, Any] = {}
     notes: tuple[str, ...] = ()
     needed = None  # the cycle's mean driving moment on the fine grid (decides whether k_dyn exists)
@@ -158,7 +183,7 @@ def run_dynamics(mech: Mechanism, method: str = "course", *, positions: int | No
         needed = fine_cycle(mech, spec, FINE_SAMPLES).driving
     _, ends = cycle_positions(mech, spec)
     motion = analyze(mech, law.phi, order=2, omega=law.omega, eps=law.eps)
-    reactions = solve_reactions(motion, ends=ends)
+    reactions = solve_reactions(motion, ends=ends, friction=spec.friction)
     k_dyn, k_notes = _dynamic_coefficient(law, reactions.balancing_moment, needed)
     return DynamicsReport(mech, law, reactions.balancing_moment, k_dyn, comparison,
                           reactions.notes + notes + k_notes)

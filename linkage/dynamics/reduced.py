@@ -32,7 +32,9 @@ from assur.base import point_analogs
 
 from ..errors import DynamicsInputError
 from ..kinematics.motion import analyze
+from ..kinetostatics.friction import Friction
 from ..kinetostatics.loads import Loads, evaluate_loads, loads_of
+from ..kinetostatics.reactions import solve_reactions
 from ..model.mechanism import Mechanism
 
 __all__ = ["Reduced", "reduced_characteristics", "link_inertia_terms"]
@@ -49,13 +51,17 @@ class Reduced:
     rotation : int
         ``s``: +1 counter-clockwise, -1 clockwise.
     moment_resistance, moment_driving : ndarray (N,)
-        ``M_c`` and the driving part of the declared loads, reduced to psi, N m.
+        ``M_c`` and the driving part of the declared loads, reduced to psi, N m (``M_c`` with the
+        friction's reduced moment where friction is asked).
     inertia_constant : float
         ``I_0``, kg m^2.
     inertia_variable : ndarray (N,)
         ``I''``, kg m^2.
     inertia_derivative : ndarray (N,)
         ``dI/dpsi``, kg m^2 / rad.
+    moment_friction : ndarray (N,) or None
+        The friction's reduced moment ``M_f,red = Σ P_friction / ω`` (<= 0, part of
+        ``moment_resistance``), N m; None without friction.
     """
 
     phi: np.ndarray
@@ -65,6 +71,7 @@ class Reduced:
     inertia_constant: float
     inertia_variable: np.ndarray
     inertia_derivative: np.ndarray
+    moment_friction: np.ndarray | None = None
 
     @property
     def inertia(self) -> np.ndarray:
@@ -101,6 +108,8 @@ def reduced_characteristics(
     loads: Loads | None = None,
     extra_inertia: float = 0.0,
     ends: ArrayLike | None = None,
+    friction: Friction | None = None,
+    speed: float | None = None,
 ) -> Reduced:
     """Reduced moments and moment of inertia at the input angles ``phi``.
 
@@ -118,6 +127,12 @@ def reduced_characteristics(
         kg m^2.
     ends : array_like of bool, optional
         Positions that end the cycle (two-valued loads at stroke ends, docs/methods.md#loads).
+    friction : Friction, optional
+        Friction in the pairs: its reduced moment joins ``M_c``. The reactions it depends on are
+        those at the constant ``speed`` (rad/s, signed; the inertia loads at that speed, eps = 0).
+    speed : float, optional
+        The speed of the friction's kinetostatics (default ``rotation`` rad/s: no inertia worth
+        the name; give the mean speed).
 
     Raises
     ------
@@ -145,10 +160,16 @@ def reduced_characteristics(
             driving += power
         else:
             resisting += power
+    lost = None
+    if friction:
+        at_speed = motion if speed is None else analyze(mech, phi, order=2, omega=float(speed), eps=0.0)
+        reactions = solve_reactions(at_speed, loads, ends=ends, friction=friction, sense=rotation)
+        lost = rotation * reactions.friction_power() / reactions.speed()
+        resisting = resisting + lost
     crank = motion.structure.inputs[0]   # further inputs (mobility W > 1) turn by their laws: variable terms
     others = [k for k in mech.moving_links if k != crank]
     variable, half_derivative = link_inertia_terms(motion, others)
     # the input link's own inertia (a cylinder's driver is no link: every link is a variable term)
     own, _ = link_inertia_terms(motion, [crank] if crank in mech.links else [])
     return Reduced(motion.phi, rotation, resisting, driving, float(own[0]) + float(extra_inertia),
-                   variable, 2 * rotation * half_derivative)
+                   variable, 2 * rotation * half_derivative, lost)

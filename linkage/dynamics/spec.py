@@ -125,6 +125,11 @@ class DynamicsSpec:
         starting torque, see :func:`~.equation.simulate`).
     cycles : int
         Cycles of the start-up transient.
+    friction : Friction or None
+        Coulomb friction in the pairs (:mod:`linkage.kinetostatics.friction`) whose reduced
+        moment joins the resistance, computed at the mean speed; None: frictionless (the default;
+        ``run_dynamics(..., friction=True)`` and ``linkage dynamics --friction`` take the
+        scheme's ``[friction]``).
     """
 
     mean_speed: float
@@ -137,6 +142,7 @@ class DynamicsSpec:
     motor: Any = None
     initial_speed: float | None = None
     cycles: int = 10
+    friction: Any = None
 
     @property
     def rotation(self) -> int:

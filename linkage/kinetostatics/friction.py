@@ -112,16 +112,18 @@ def parse_friction(mech: Mechanism, raw: Mapping[str, Any] | None) -> tuple[Fric
         if entry is not None:
             own[name] = entry
     result: dict[str, PairFriction] = {}
+    no_radius: dict[str, list[str]] = {}
     for name, pair in sorted(mech.pairs.items()):
         spec = {**defaults.get(pair.kind, {}), **own.get(name, {})}
         if not spec or spec.get("f", 0.0) == 0.0:
             continue
         if pair.kind == "R" and spec.get("radius") is None:
-            where = f"pairs.{name}" if name in own else "revolute"
-            problems.append(f"{where}: revolute pair '{name}' needs radius = r (m, the journal's radius: the "
-                            "friction moment is f·r·|R|)")
+            no_radius.setdefault(f"pairs.{name}" if name in own else "revolute", []).append(name)
             continue
         result[name] = PairFriction(name, pair.kind, spec["f"], spec.get("radius"), spec.get("length"))
+    for where, names in no_radius.items():
+        problems.append(f"{where}: needs radius = r (m, the journal's radius: the friction moment is f·r·|R|) "
+                        f"for the revolute pair(s) {', '.join(names)}")
     return Friction(result), problems
 
 

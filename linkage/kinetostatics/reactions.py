@@ -188,8 +188,9 @@ class Reactions:
         prismatic pairs, ``K.M`` (N m, the moment of the slider on the guide about the slider's
         point). Pairs in the order of their names. ``direction``: see :meth:`Motion.columns`.
         With friction: ``efficiency`` (η, :meth:`efficiency`), ``power_lost`` (W, every pair's
-        friction) and per pair with friction ``K.friction`` (:meth:`friction_load`: N m on the
-        pair's first link, or N on the slider along the guide) and ``K.power_lost`` (W, >= 0)."""
+        friction) and per pair with friction ``K.Mf`` (revolute: the friction moment on the pair's
+        first link, N m) or ``K.Ff`` (prismatic: the friction force on the slider along the guide,
+        N), and ``K.power_lost`` (W, >= 0): see :meth:`friction_load`."""
         cols = self.motion.position_columns(direction)
         load = self.motion.mechanism.coordinate.load
         cols[f"balancing_{load}"] = self.balancing_moment
@@ -210,7 +211,8 @@ class Reactions:
                 if isinstance(self.motion.joints[name], PrismaticJoint):
                     cols[f"{name}.M"] = self.moment(name)
             if self.friction and name in self.friction.pairs:
-                cols[f"{name}.friction"] = self.friction_load(name)
+                kind = "Ff" if isinstance(self.motion.joints[name], PrismaticJoint) else "Mf"
+                cols[f"{name}.{kind}"] = self.friction_load(name)
                 cols[f"{name}.power_lost"] = -self.friction_power(name)
         return cols
 

@@ -24,6 +24,7 @@ from ..dynamics.pipeline import DynamicsReport, run_dynamics
 from ..errors import InputError
 from ..kinematics.extremes import table_angles
 from ..kinematics.motion import Motion, analyze, position_column, table_positions_deg
+from ..kinetostatics.efficiency import cycle_works
 from ..kinetostatics.reactions import solve_reactions, virtual_power_residual
 from ..model.mechanism import Mechanism
 from ..model.scheme import section_of
@@ -55,10 +56,11 @@ class DynamicsResults:
 
 
 def dynamics_results(mech: Mechanism, method: str = "course", *, positions: int | None = None,
-                     delta: float | None = None, mean_speed: float | None = None) -> DynamicsResults:
+                     delta: float | None = None, mean_speed: float | None = None,
+                     friction: bool = False) -> DynamicsResults:
     """Run :func:`linkage.dynamics.pipeline.run_dynamics` and arrange its results as ``linkage dynamics``
     prints them (arguments and errors as there)."""
-    report = run_dynamics(mech, method, positions=positions, delta=delta, mean_speed=mean_speed)
+    report = run_dynamics(mech, method, positions=positions, delta=delta, mean_speed=mean_speed, friction=friction)
     law = report.law
     summary = {"scheme": mech.name, "positions": len(law.phi) - 1, "phi0_deg": float(np.degrees(law.phi[0])),
                "direction": law.reduced.rotation, **report.summary()}
@@ -278,10 +280,13 @@ def kinematics_results(mech: Mechanism, positions: int | None = None,
 
 
 def forces_results(mech: Mechanism, positions: int | None = None, start: str | float | InputRange | None = None,
-                   omega: float | None = None, eps: float = 0.0) -> TableResults:
+                   omega: float | None = None, eps: float = 0.0, friction: bool = False) -> TableResults:
     """The table of ``linkage forces``: reactions and the balancing moment at the scheme's table
     positions, at the input speed ``omega`` (rad/s, signed; default the scheme's mean speed, else
-    a static analysis) and acceleration ``eps`` (rad/s^2)."""
+    a static analysis) and acceleration ``eps`` (rad/s^2); with ``friction`` the scheme's
+    ``[friction]`` in the pairs (the losses per pair, the efficiency per position and, for a crank
+    that turns fully, the works and the efficiency of one turn at constant speed in
+    ``meta["cycle"]``)."""
 
     notes: list[str] = []
     spec = section_of(mech, "dynamics")
@@ -298,8 +303,9 @@ def forces_results(mech: Mechanism, positions: int | None = None, start: str | f
         motion = analyze(mech, phi, order=2, omega=omega, eps=eps, on_failure="mask")
         ends = np.zeros(len(phi), bool)
         ends[-1] = True
-        reactions = solve_reactions(motion, ends=ends)
+        reactions = solve_reactions(motion, ends=ends, friction=friction, sense=direction)
         residual = virtual_power_residual(reactions)
+        cycle = friction_cycle(mech, omega, notes) if friction else None
     failed, lines = failures(motion)
     notes += list(reactions.notes)
     meta = {"scheme": mech.name, "formula": structure_of(mech).formula, "omega": omega, "eps": eps,
@@ -307,4 +313,36 @@ def forces_results(mech: Mechanism, positions: int | None = None, start: str | f
             "convention": REACTION_CONVENTION,
             "virtual_power_residual_max": float(np.nanmax(residual)) if np.isfinite(residual).any() else None,
             "failed": failed, "notes": list(reactions.notes)}
-    return TableResults(reactions.columns(full=True), meta, motion, notes, lines + _caught(caught, failed), reactions)
+    if friction:
+        meta["friction"] = {name: {k: v for k, v in (("kind", p.kind), ("f", p.f), ("radius", p.radius),
+                                                      ("length", p.length)) if v is not None}
+                            for name, p in reactions.friction.pairs.items()}
+        meta["self_locking_positions"] = [int(i) + 1 for i in np.flatnonzero(reactions.locked)]
+        meta["cycle"] = cycle
+    return TableResults(_friction_first(reactions.columns(full=True)), meta, motion, notes,
+                        lines + _caught(caught, failed), reactions)
+
+
+def _friction_first(columns: dict) -> dict:
+    """The columns with ``efficiency`` and ``power_lost`` right after the balancing load."""
+    order = list(columns)
+    for name in ("power_lost", "efficiency"):
+        if name in columns:
+            order.remove(name)
+            at = next(i for i, k in enumerate(order) if k.startswith("balancing_")) + 1
+            order.insert(at, name)
+    return {k: columns[k] for k in order}
+
+
+def friction_cycle(mech: Mechanism, omega: float | None, notes: list[str]) -> dict | None:
+    """The works of one turn with friction at constant speed (``cycle_works``) as a table's meta,
+    None (with a note) where the input is not a crank turning fully."""
+    try:
+        works = cycle_works(mech, omega, friction=True)
+    except InputError as exc:
+        notes.append(f"no cycle efficiency: {exc}")
+        return None
+    unit = "J" if omega else "J per rad/s (static analysis)"
+    return {"driving_work": works.driving, "useful_work": works.useful, "friction_work": works.friction,
+            "efficiency": works.efficiency, "samples": works.samples, "locked_samples": works.locked,
+            "omega": works.omega, "unit": unit}

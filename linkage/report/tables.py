@@ -253,6 +253,8 @@ _NAMED_UNITS = {
     "a": "m/s^2",
     "force": "N",
     "reduced_force": "N",
+    "power_lost": "W",
+    "reduced_moment_friction": "N m",
     "reduced_mass": "kg",
 }
 
@@ -264,6 +266,8 @@ _QUANTITY_UNITS = {
     "theta": ("rad", "rad/rad", "rad/rad^2"),  # link angle and its analogs
     "R": ("N",), "Rx": ("N",), "Ry": ("N",),  # pair reaction: magnitude, components
     "M": ("N m",),                         # moment in a prismatic pair
+    "Mf": ("N m",), "Ff": ("N",),          # friction moment (revolute pair) and force (prismatic pair)
+    "power_lost": ("W",),                  # power friction takes in a pair
 }
 
 
