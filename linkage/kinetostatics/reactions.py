@@ -33,7 +33,7 @@ from assur.rows import rows_of
 from ..errors import InputError
 from ..kinematics.inputs import input_angles
 from ..kinematics.motion import Motion, angle_in_half_turn
-from .friction import Friction, friction_angle_deg, friction_of, friction_terms, group_with_friction
+from .friction import Friction, friction_angle_deg, friction_of, group_with_friction
 from .loads import Loads, LoadTerm, evaluate_loads, generalized_loads, inertia_terms, loads_of
 
 __all__ = ["Reactions", "reactions_under", "solve_reactions", "virtual_power_residual"]
