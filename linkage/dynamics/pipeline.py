@@ -86,14 +86,20 @@ class DynamicsReport:
         }
 
     def _friction_summary(self) -> dict[str, float]:
-        """With friction: the work it takes per cycle (J, the trapezoid over the table positions, as
-        the course integrates A_c) and the cycle's efficiency ``1 − A_friction / A_driving``."""
-        red, law = self.law.reduced, self.law
-        if red.moment_friction is None:
+        """With friction: the work it takes per cycle (J) and the cycle's efficiency
+        ``1 − A_friction / A_driving``, on the grid the method integrates A_c on (the table
+        positions for the course method, its fine grid for the exact method and the equation of
+        motion), so ``A_driving`` is the method's own."""
+        law = self.law
+        if law.reduced.moment_friction is None:
             return {}
-        psi = np.abs(law.phi - law.phi[0])
+        fine = law.details.get("fine_cycle")
+        if fine is not None:
+            red, psi, driving = fine.reduced, fine.psi, law.driving_moment * 2 * np.pi
+        else:
+            red, psi = law.reduced, np.abs(law.phi - law.phi[0])
+            driving = float(np.trapezoid(red.moment_driving + law.driving, psi))
         lost = -float(np.trapezoid(red.moment_friction, psi))
-        driving = float(np.trapezoid(red.moment_driving + law.driving, psi))
         return {"friction_work": lost, "cycle_efficiency": 1 - lost / driving if driving > 0 else None}
 
     def summary(self) -> dict[str, Any]:

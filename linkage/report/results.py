@@ -318,6 +318,10 @@ def forces_results(mech: Mechanism, positions: int | None = None, start: str | f
                                                       ("length", p.length)) if v is not None}
                             for name, p in reactions.friction.pairs.items()}
         meta["self_locking_positions"] = [int(i) + 1 for i in np.flatnonzero(reactions.locked)]
+        if motion.omega is None:
+            notes.append("static analysis: the friction opposes the input's "
+                         f"{'increasing' if direction > 0 else 'decreasing'} coordinate; power_lost and K.power_lost "
+                         "are per unit of its speed (W per rad/s, i.e. N m; W per m/s for a slide input)")
         meta["cycle"] = cycle
     return TableResults(_friction_first(reactions.columns(full=True)), meta, motion, notes,
                         lines + _caught(caught, failed), reactions)
@@ -342,7 +346,7 @@ def friction_cycle(mech: Mechanism, omega: float | None, notes: list[str]) -> di
     except InputError as exc:
         notes.append(f"no cycle efficiency: {exc}")
         return None
-    unit = "J" if omega else "J per rad/s (static analysis)"
-    return {"driving_work": works.driving, "useful_work": works.useful, "friction_work": works.friction,
-            "efficiency": works.efficiency, "samples": works.samples, "locked_samples": works.locked,
+    unit = "J"
+    return {"driving_work": works.driving + 0.0, "useful_work": works.useful + 0.0,
+            "friction_work": works.friction + 0.0, "efficiency": works.efficiency + 0.0, "samples": works.samples, "locked_samples": works.locked,
             "omega": works.omega, "unit": unit}
