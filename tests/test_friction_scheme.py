@@ -162,3 +162,28 @@ def test_friction_with_f_zero_in_every_pair_is_frictionless():
     none = Friction({})
     a, b = solve_reactions(motion), solve_reactions(motion, friction=none)
     np.testing.assert_array_equal(a.balancing_moment, b.balancing_moment)
+
+
+@pytest.mark.parametrize("method", ["course", "exact"])
+def test_friction_under_the_law_of_motion_is_that_of_its_own_speeds(method):
+    """With real_speed the friction's reduced moment at the table positions is the one the
+    kinetostatics gives under the final law's omega(phi) and eps(phi) (computed here directly),
+    to the settling tolerance; it differs from the mean-speed one by the inertia loads' share."""
+    mech = press()
+    report = run_dynamics(mech, method, friction=True, real_speed=True, compare=False)
+    law = report.law
+    assert any("settled in" in n for n in report.notes)
+    motion = linkage.analyze(mech, law.phi, order=2, omega=law.omega, eps=law.eps)
+    ends = np.arange(len(law.phi)) == len(law.phi) - 1        # the last position ends the cycle
+    reactions = solve_reactions(motion, ends=ends, friction=True, sense=law.reduced.rotation)
+    direct = law.reduced.rotation * reactions.friction_power() / motion.omega
+    scale = np.max(np.abs(direct))
+    # the last position repeats the first (its speed taken as the first's: the law is periodic)
+    np.testing.assert_allclose(law.reduced.moment_friction[:-1], direct[:-1], atol=1e-5 * scale)
+    at_mean = run_dynamics(mech, method, friction=True, compare=False).law.reduced.moment_friction
+    assert np.max(np.abs(at_mean - direct)) > 1e-4 * scale
+
+
+def test_real_speed_needs_friction(linkage_run):
+    run = linkage_run("dynamics", "course_slider_crank", "--friction-real-speed")
+    assert run.status == 2 and "give --friction with it" in run.err

@@ -78,6 +78,10 @@ def add(sub) -> None:
                         "reduced moment at the mean speed (column reduced_moment_friction, N m) joins the "
                         "resistance, so the driving moment, the flywheel and the motor account for it; the "
                         "summary gains friction_work (J per cycle) and cycle_efficiency")
+    p.add_argument("--friction-real-speed", action="store_true",
+                   help="with --friction: compute the friction's reactions under the law of motion's own "
+                        "omega(phi), eps(phi) instead of the mean speed, repeating the method until the flywheel "
+                        "and the driving moment settle (to 1e-6; a note says in how many rounds)")
     add_columns_argument(p)
     add_format_argument(p)
     p.set_defaults(handler=run)
@@ -135,6 +139,9 @@ def run(args: argparse.Namespace) -> int:
         given = "--force" if args.force is not None else "--initial-speed"
         raise InputError(f"{given}: scheme '{mech.name}' is driven by a crank (input '{mech.inputs[0]}'); "
                          "--force and --initial-speed are for a slide input")
+    if args.friction_real_speed and not args.friction:
+        raise InputError("--friction-real-speed: give --friction with it (the friction it computes under the law "
+                         "of motion is the scheme's [friction])")
     if args.transient and args.method != "ode":
         raise InputError(f"--transient: the start-up is a solution of the equation of motion with the "
                          f"motor: give --method ode with it (got --method {args.method})")
@@ -153,7 +160,8 @@ def run(args: argparse.Namespace) -> int:
         note("note", f"{first}shooting for the motor-driven steady state{then}; this takes a few seconds")
     with _options_named(args):
         results = dynamics_results(mech, args.method, positions=args.positions, delta=args.delta,
-                                   mean_speed=input_speed(args, mech), friction=args.friction)
+                                   mean_speed=input_speed(args, mech), friction=args.friction,
+                                   real_speed=args.friction_real_speed)
     report, summary = results.report, dict(results.summary)
     for line in report.notes:
         note("note", line)

@@ -148,7 +148,7 @@ def course_method(mech: Mechanism, spec: DynamicsSpec | None = None, *, position
     phi, ends = cycle_positions(mech, spec)
     n = len(phi) - 1
     red = reduced_characteristics(mech, phi, spec.rotation, extra_inertia=spec.constant_inertia, ends=ends,
-                                  friction=spec.friction, speed=spec.mean_speed)
+                                  friction=spec.friction, speed=spec.friction_speed)
     step = 2 * np.pi / n
     work = np.concatenate([[0.0], np.cumsum((red.moment[1:] + red.moment[:-1]) / 2 * step)])
     driving = -work[-1] / (2 * np.pi)
@@ -202,7 +202,7 @@ def fine_cycle(mech: Mechanism, spec: DynamicsSpec, samples: int) -> _Cycle:
     n = spec.positions * max(1, math.ceil(samples / spec.positions))
     phi, ends = cycle_positions(mech, spec, n)
     red = reduced_characteristics(mech, phi, spec.rotation, extra_inertia=spec.constant_inertia, ends=ends,
-                                  friction=spec.friction, speed=spec.mean_speed)
+                                  friction=spec.friction, speed=spec.friction_speed)
     psi = np.arange(n + 1) * 2 * np.pi / n
     work = np.concatenate([[0.0], np.cumsum((red.moment[1:] + red.moment[:-1]) / 2 * np.diff(psi))])
     driving = -work[-1] / (2 * np.pi)

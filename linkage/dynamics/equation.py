@@ -604,7 +604,7 @@ def steady_state(mech: Mechanism, spec: DynamicsSpec | None = None, *, constant_
     phi, ends = cycle_positions(mech, spec, n)
     psi = np.arange(n + 1) * 2 * np.pi / n
     red = reduced_characteristics(mech, phi, spec.rotation, extra_inertia=spec.constant_inertia, ends=ends,
-                                  friction=spec.friction, speed=spec.mean_speed)
+                                  friction=spec.friction, speed=spec.friction_speed)
     inertia = constant + red.inertia_variable
     w = np.sqrt(2 * sol.sol(psi)[0] / inertia)
     fine = np.linspace(0, 2 * np.pi, 20 * n + 1)

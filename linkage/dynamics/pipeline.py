@@ -13,9 +13,10 @@ is a note saying where and why: the steady state stands without it).
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
+from scipy.interpolate import CubicSpline
 
 from ..errors import DynamicsInputError
 from ..kinematics.motion import analyze, table_positions_deg
@@ -122,7 +123,7 @@ class DynamicsReport:
 
 def run_dynamics(mech: Mechanism, method: str = "course", *, positions: int | None = None,
                  delta: float | None = None, mean_speed: float | None = None,
-                 compare: bool = True, friction: bool = False) -> DynamicsReport:
+                 compare: bool = True, friction: bool = False, real_speed: bool = False) -> DynamicsReport:
     """The whole pipeline: law of motion by ``method``, then kinetostatics under the real motion.
 
     Parameters
@@ -139,6 +140,11 @@ def run_dynamics(mech: Mechanism, method: str = "course", *, positions: int | No
         Friction in the pairs from the scheme's ``[friction]``: its reduced moment (at the mean
         speed) joins the resistance of every method, so the flywheel and the motor account for it,
         and the reactions under the real motion include it.
+    real_speed : bool
+        With ``friction``: compute the friction's reactions under the law of motion's own
+        omega(phi) and eps(phi) instead of the mean speed, repeating the method until the required
+        inertia and the driving moment change by less than :data:`REAL_SPEED_TOL` (at most
+        :data:`REAL_SPEED_ROUNDS` rounds; a note says when they did not settle).
 
     Raises
     ------
@@ -160,8 +166,22 @@ def run_dynamics(mech: Mechanism, method: str = "course", *, positions: int | No
     comparison: dict[str, Any] = {}
     notes: tuple[str, ...] = ()
     needed = None  # the cycle's mean driving moment on the fine grid (decides whether k_dyn exists)
+    sized = None   # the ode method's flywheel, by the exact method
+
+    def solve(spec: DynamicsSpec) -> LawOfMotion:
+        nonlocal sized
+        if method == "course":
+            return course_method(mech, spec)
+        if method == "exact":
+            return exact_method(mech, spec)
+        sized = exact_method(mech, spec) if spec.delta is not None else None
+        return steady_state(mech, spec, constant_inertia=sized and sized.constant_inertia)
+
+    law = solve(spec)
+    if friction and real_speed:
+        spec, law, settled = _friction_under_the_law(spec, law, solve)
+        notes += settled
     if method == "course":
-        law = course_method(mech, spec)
         if compare and spec.delta < DELTA_RESOLVED:
             notes += (f"delta = {spec.delta:.3g} is below what the exact method resolves ({DELTA_RESOLVED:g}): "
                       "no comparison with it",)
@@ -176,11 +196,8 @@ def run_dynamics(mech: Mechanism, method: str = "course", *, positions: int | No
                 "course_delta_exact": _course_delta_exactly(spec, law, exact),
             }
     elif method == "exact":
-        law = exact_method(mech, spec)
         needed = law.driving_moment
     else:
-        sized = exact_method(mech, spec) if spec.delta is not None else None
-        law = steady_state(mech, spec, constant_inertia=sized and sized.constant_inertia)
         needed = sized and sized.driving_moment
         if spec.initial_speed is not None:
             comparison, settling_notes = _settling(mech, spec, law)
@@ -193,6 +210,47 @@ def run_dynamics(mech: Mechanism, method: str = "course", *, positions: int | No
     k_dyn, k_notes = _dynamic_coefficient(law, reactions.balancing_moment, needed)
     return DynamicsReport(mech, law, reactions.balancing_moment, k_dyn, comparison,
                           reactions.notes + notes + k_notes)
+
+
+#: relative change of the required inertia and of the driving moment at which the friction under
+#: the law of motion has settled
+REAL_SPEED_TOL = 1e-6
+#: rounds of the method with the friction under the previous round's law of motion
+REAL_SPEED_ROUNDS = 12
+
+
+def law_motion(law: LawOfMotion) -> Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]:
+    """``motion(phi) -> (omega, eps)``: the law's speed and acceleration at any input angle, by
+    periodic cubic splines over the angle turned through its table positions."""
+    rotation = law.reduced.rotation
+    psi = rotation * (law.phi - law.phi[0])
+    omega, eps = np.array(law.omega, float), np.array(law.eps, float)
+    omega[-1], eps[-1] = omega[0], eps[0]
+    speed, acceleration = (CubicSpline(psi, v, bc_type="periodic") for v in (omega, eps))
+
+    def motion(phi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        turned = np.mod(rotation * (np.asarray(phi, float) - law.phi[0]), 2 * np.pi)
+        return speed(turned), acceleration(turned)
+
+    return motion
+
+
+def _friction_under_the_law(spec: DynamicsSpec, law: LawOfMotion, solve) -> tuple[DynamicsSpec, LawOfMotion,
+                                                                                   tuple[str, ...]]:
+    """Repeat ``solve`` with the friction computed under the previous law of motion until the
+    required inertia and the driving moment settle (:data:`REAL_SPEED_TOL`)."""
+    for rounds in range(1, REAL_SPEED_ROUNDS + 1):
+        spec = replace(spec, friction_motion=law_motion(law))
+        new = solve(spec)
+        change = max(abs(new.required_constant_inertia - law.required_constant_inertia)
+                     / max(abs(law.required_constant_inertia), 1e-300),
+                     abs(new.driving_moment - law.driving_moment) / max(abs(law.driving_moment), 1e-300))
+        law = new
+        if change <= REAL_SPEED_TOL:
+            return spec, law, (f"friction under the law of motion's omega(phi), eps(phi): settled in {rounds} "
+                               f"round(s) (last change {change:.1e})",)
+    return spec, law, (f"friction under the law of motion's omega(phi), eps(phi): not settled after {REAL_SPEED_ROUNDS} "
+                       f"rounds (last change {change:.1e} > {REAL_SPEED_TOL:g}); the results are the last round's",)
 
 
 def _dynamic_coefficient(law: LawOfMotion, balancing: np.ndarray, needed: float) -> tuple[float | None,

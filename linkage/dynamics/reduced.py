@@ -24,6 +24,7 @@ With ``s = sign(omega_m)`` and ``psi = s phi`` (the angle in the direction of ro
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -109,7 +110,7 @@ def reduced_characteristics(
     extra_inertia: float = 0.0,
     ends: ArrayLike | None = None,
     friction: Friction | None = None,
-    speed: float | None = None,
+    speed: float | Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]] | None = None,
 ) -> Reduced:
     """Reduced moments and moment of inertia at the input angles ``phi``.
 
@@ -129,10 +130,11 @@ def reduced_characteristics(
         Positions that end the cycle (two-valued loads at stroke ends, docs/methods.md#loads).
     friction : Friction, optional
         Friction in the pairs: its reduced moment joins ``M_c``. The reactions it depends on are
-        those at the constant ``speed`` (rad/s, signed; the inertia loads at that speed, eps = 0).
-    speed : float, optional
-        The speed of the friction's kinetostatics (default ``rotation`` rad/s: no inertia worth
-        the name; give the mean speed).
+        those under ``speed`` (the inertia loads of that motion).
+    speed : float or callable, optional
+        The motion of the friction's kinetostatics: a constant speed (rad/s, signed; eps = 0), or
+        ``speed(phi) -> (omega, eps)`` arrays at the input angles (a law of motion). Default
+        ``rotation`` rad/s (no inertia worth the name: give the mean speed).
 
     Raises
     ------
@@ -162,7 +164,13 @@ def reduced_characteristics(
             resisting += power
     lost = None
     if friction:
-        at_speed = motion if speed is None else analyze(mech, phi, order=2, omega=float(speed), eps=0.0)
+        if speed is None:
+            at_speed = motion
+        elif callable(speed):
+            omega, eps = speed(motion.phi)
+            at_speed = analyze(mech, motion.phi, order=2, omega=omega, eps=eps)
+        else:
+            at_speed = analyze(mech, motion.phi, order=2, omega=float(speed), eps=0.0)
         reactions = solve_reactions(at_speed, loads, ends=ends, friction=friction, sense=rotation)
         lost = rotation * reactions.friction_power() / reactions.speed()
         resisting = resisting + lost

@@ -127,9 +127,13 @@ class DynamicsSpec:
         Cycles of the start-up transient.
     friction : Friction or None
         Coulomb friction in the pairs (:mod:`linkage.kinetostatics.friction`) whose reduced
-        moment joins the resistance, computed at the mean speed; None: frictionless (the default;
+        moment joins the resistance; None: frictionless (the default;
         ``run_dynamics(..., friction=True)`` and ``linkage dynamics --friction`` take the
         scheme's ``[friction]``).
+    friction_motion : callable or None
+        The motion the friction's reactions are computed under: ``friction_motion(phi) ->
+        (omega, eps)`` arrays (rad/s, rad/s^2) at the input angles ``phi``; None: the mean
+        speed, eps = 0 (the course's approximation). :attr:`friction_speed` gives the one used.
     """
 
     mean_speed: float
@@ -143,6 +147,12 @@ class DynamicsSpec:
     initial_speed: float | None = None
     cycles: int = 10
     friction: Any = None
+    friction_motion: Any = None
+
+    @property
+    def friction_speed(self) -> Any:
+        """The speed the friction is computed at: ``friction_motion`` or the mean speed."""
+        return self.friction_motion if self.friction_motion is not None else self.mean_speed
 
     @property
     def rotation(self) -> int:

@@ -57,10 +57,11 @@ class DynamicsResults:
 
 def dynamics_results(mech: Mechanism, method: str = "course", *, positions: int | None = None,
                      delta: float | None = None, mean_speed: float | None = None,
-                     friction: bool = False) -> DynamicsResults:
+                     friction: bool = False, real_speed: bool = False) -> DynamicsResults:
     """Run :func:`linkage.dynamics.pipeline.run_dynamics` and arrange its results as ``linkage dynamics``
     prints them (arguments and errors as there)."""
-    report = run_dynamics(mech, method, positions=positions, delta=delta, mean_speed=mean_speed, friction=friction)
+    report = run_dynamics(mech, method, positions=positions, delta=delta, mean_speed=mean_speed, friction=friction,
+                          real_speed=real_speed)
     law = report.law
     summary = {"scheme": mech.name, "positions": len(law.phi) - 1, "phi0_deg": float(np.degrees(law.phi[0])),
                "direction": law.reduced.rotation, **report.summary()}
