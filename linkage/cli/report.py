@@ -20,16 +20,22 @@ def add(sub) -> None:
                     "flywheel, omega and eps two ways, start-up with the motor); animation.gif, one "
                     "revolution; and index.html, one page with the data, the structural formula, the "
                     "results and every picture. Pictures the scheme's data does not allow are left "
-                    "out with a note. Needs the 'report' extra: pip install \"linkage[report]\".")
+                    "out with a note. With --friction the forces and the dynamics include the scheme's "
+                    "[friction], and friction.csv and friction.png/svg (the power lost in each pair and "
+                    "the efficiency) are added. Needs the 'report' extra: pip install \"linkage[report]\".")
     add_scheme_argument(p)
     p.add_argument("--out", "-o", metavar="DIR", required=True, help="the folder to write (created)")
+    p.add_argument("--friction", action="store_true",
+                   help="Coulomb friction in the pairs from the scheme's [friction] (docs/friction.md): the "
+                        "forces and the dynamics include it, friction.csv holds the efficiency and the power "
+                        "lost per pair at each position, friction.png/svg draws them")
     p.set_defaults(handler=run)
 
 
 def run(args: argparse.Namespace) -> int:
     require_report_extra()
     mech = load_scheme(args)
-    report = write_report(mech, args.out, progress=progress("report"))
+    report = write_report(mech, args.out, progress=progress("report"), friction=args.friction)
     for line in report.notes:
         note("note", line)
     out(f"{Path(args.out) / 'index.html'}: {len(report.pictures)} pictures, {len(report.files)} files")

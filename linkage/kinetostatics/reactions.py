@@ -21,7 +21,7 @@ True
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Iterable
 
 import numpy as np
@@ -127,10 +127,13 @@ class Reactions:
         return np.full(len(self.motion.phi), self.sense)
 
     def term_power(self, term: LoadTerm) -> np.ndarray:
-        """The power of one load term (N,), W: ``(F·r'_P + M·θ')·ω``."""
+        """The power of one load term (N,), W: ``(F·r'_P + M·θ')·ω``; 0 where it is round-off
+        (below 1e-12 of the power the load would have at the mechanism's typical speed, as
+        :func:`virtual_power_residual` scales it: a load at a dead centre does no work)."""
         v, _ = point_analogs(self.motion.poses[term.link], self.motion.first[term.link], None, term.local)
         analog = np.einsum("ni,ni->n", term.force, v) + term.moment * self.motion.first[term.link][:, 2]
-        return analog * self.speed()
+        typical = np.hypot(term.force[:, 0], term.force[:, 1]) * self.motion.mechanism.size + np.abs(term.moment)
+        return np.where(np.abs(analog) <= 1e-12 * typical, 0.0, analog) * self.speed() + 0.0
 
     def friction_load(self, pair: str) -> np.ndarray:
         """The friction in ``pair`` (N,): for a revolute pair the moment on its first link (N m),
@@ -375,6 +378,8 @@ def reactions_under(motion: Motion, terms: list[LoadTerm], pairs: Iterable[str] 
         multipliers = {k: np.where(bad[:, None], np.nan, v) for k, v in multipliers.items()}
     if friction and locked.any():
         notes = notes + (_locked_note(motion, friction, locked, locked_pair),)
+        terms = [replace(t, force=np.where(locked[:, None], np.nan, t.force), moment=np.where(locked, np.nan, t.moment))
+                 if t.kind == "friction" else t for t in terms]
     return Reactions(motion, multipliers, balancing[structure.inputs[0]], terms, notes, balancing, friction=friction,
                      locked=locked if friction else None, locked_pair=locked_pair if friction else None,
                      sense=static)

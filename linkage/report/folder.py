@@ -6,7 +6,9 @@ scheme's data, its structural formula, the results and every picture inline, wri
 Jinja2 template), the pictures in PNG and SVG and ``animation.gif``, a film of one revolution.
 A picture the scheme's data does not allow (no [dynamics] section: no flywheel; no motor: no
 start-up; no loads and no masses: no hodographs) is left out with a note saying why; the page
-lists the notes too.
+lists the notes too. With ``friction=True`` (``--friction``) the forces and the dynamics include
+the scheme's [friction], ``friction.csv`` holds the losses and the efficiency per position, and
+``friction.png``/``.svg`` draws them (docs/friction.md).
 
 Needs the ``report`` extra (matplotlib, Jinja2, tqdm): ``pip install "linkage[report]"``.
 """
@@ -25,6 +27,7 @@ import numpy as np
 from assur.base import OK
 
 from ..errors import InputError, LinkageError
+from ..kinetostatics.friction import friction_of
 from ..model.mechanism import Mechanism, Prismatic
 from ..model.scheme import dumps, section_of
 from ..structure import structure_of
@@ -33,6 +36,7 @@ from . import machine
 from .animation import write_animation
 from .diagrams import plot_columns, plot_dynamics, plot_motion
 from .drawing import draw_mechanism, draw_positions
+from .friction_plots import plot_friction
 from .hodographs import plot_hodographs
 from .resistance import plot_resistance, resistance_curves
 from .results import dynamics_results, forces_results, kinematics_results
@@ -73,7 +77,8 @@ class Report:
 
 
 def write_report(mech: Mechanism, out: str | Path, *,
-                 progress: Callable[[Iterable, int], Iterable] | None = None, frames: int = 72) -> Report:
+                 progress: Callable[[Iterable, int], Iterable] | None = None, frames: int = 72,
+                 friction: bool = False) -> Report:
     """Write the analysis folder of ``mech`` into ``out`` (created; files of the same names are
     replaced).
 
@@ -85,12 +90,24 @@ def write_report(mech: Mechanism, out: str | Path, *,
         ``progress(steps, total)`` wraps the list of steps (a progress bar).
     frames : int
         Frames of the animation over one revolution (or over the input range).
+    friction : bool
+        Include the scheme's ``[friction]`` in the forces and the dynamics, and write the friction
+        table (``friction.csv``) and picture (``friction.png``, ``.svg``).
 
     Returns
     -------
     Report
+
+    Raises
+    ------
+    InputError
+        ``friction`` for a scheme without a ``[friction]`` section (before anything is written).
     """
     require_report_extra()
+    if friction and friction_of(mech) is None:
+        raise InputError(f"--friction: scheme '{mech.name}' declares no [friction] section: add one "
+                         "(docs/friction.md), e.g. [friction] revolute = { f = 0.1, radius = 0.02 } and "
+                         "prismatic = { f = 0.15 }")
     import matplotlib
 
     matplotlib.use("Agg")
@@ -99,7 +116,7 @@ def write_report(mech: Mechanism, out: str | Path, *,
         raise InputError(f"--out {out}: is a file, not a folder")
     out.mkdir(parents=True, exist_ok=True)
     report = Report(out)
-    work = _Work(mech, report)
+    work = _Work(mech, report, friction)
     steps = work.steps()
     for step in (progress(steps, len(steps)) if progress is not None else steps):
         step()
@@ -111,13 +128,15 @@ class _Work:
     """The steps of a report, each a method that writes its files (so a progress bar can count
     them), and the data the page shows."""
 
-    def __init__(self, mech: Mechanism, report: Report):
-        self.mech, self.report = mech, report
+    def __init__(self, mech: Mechanism, report: Report, friction: bool = False):
+        self.mech, self.report, self.friction = mech, report, friction
         self.kinematics = self.forces = self.dynamics = None
         self.spec = section_of(mech, "dynamics")
 
     def steps(self) -> list[Callable[[], None]]:
         steps = [self.tables, self.mechanism_pictures, self.kinematic_diagrams, self.force_pictures]
+        if self.friction:
+            steps.append(self.friction_picture)
         if self.spec is not None:
             steps += [self.dynamics_tables, self.machine_pictures, self.startup]
         elif not self.mech.coordinate.is_angle:
@@ -161,7 +180,7 @@ class _Work:
 
     def tables(self) -> None:
         self.kinematics = kinematics_results(self.mech)
-        self.forces = forces_results(self.mech)
+        self.forces = forces_results(self.mech, friction=self.friction)
         for results in (self.kinematics, self.forces):
             self.report.notes += results.notes + results.warnings
         self._write("scheme.toml", dumps(self.mech))
@@ -169,6 +188,23 @@ class _Work:
         self._write("kinematics.json", self.kinematics.json())
         self._write("forces.csv", format_columns(self.forces.columns, "csv"))
         self._write("forces.json", self.forces.json())
+        if self.friction:
+            self._friction_table()
+
+    def _friction_table(self) -> None:
+        """``friction.csv``: the balancing load, the efficiency and the losses per position; the
+        works of one turn at constant speed as a note (forces.json, key ``cycle``)."""
+        columns = self.forces.columns
+        names = [n for n in columns if n in ("i", "phi_deg", "s", "efficiency", "power_lost")
+                 or n.startswith("balancing_") or n.endswith((".Mf", ".Ff", ".power_lost"))]
+        self._write("friction.csv", format_columns({n: columns[n] for n in names}, "csv"))
+        cycle = self.forces.meta.get("cycle")
+        if cycle:
+            self.report.notes.append(
+                f"friction: one turn at constant speed ({cycle['samples']} steps): driving work "
+                f"{cycle['driving_work']:.6g} {cycle['unit']}, useful work {cycle['useful_work']:.6g}, work lost to "
+                f"friction {cycle['friction_work']:.6g}; cycle efficiency {cycle['efficiency']:.4f} "
+                "(forces.json, key cycle)")
 
     def _trajectories(self) -> list[str]:
         """The output point's path, drawn on the mechanism's pictures and the film."""
@@ -224,10 +260,17 @@ class _Work:
         who = "input link" if load == "moment" else "input slide"
         self._picture(f"balancing_{load}", f"Balancing {load} on the {who}"
                       + ("s" if len(self.mech.inputs) > 1 else "")
-                      + f" ({self._speed_note()})",
+                      + f" ({self._speed_note()}{', with friction in the pairs' if self.friction else ''})",
                       balancing)
         self._picture("hodographs", "Hodographs of the reactions in the main pairs",
                       lambda: plot_hodographs(self.forces.reactions))
+
+    def friction_picture(self) -> None:
+
+        reactions = self.forces.reactions
+        self._picture("friction", f"Friction in the pairs: the power lost in each pair and the efficiency η "
+                                  f"({self._speed_note()})",
+                      lambda: plot_friction(reactions, reactions.motion.direction))
 
     def _speed_note(self) -> str:
         """At what speed the forces were found: a static case says so."""
@@ -236,7 +279,7 @@ class _Work:
 
     def dynamics_tables(self) -> None:
         try:
-            self.dynamics = dynamics_results(self.mech)
+            self.dynamics = dynamics_results(self.mech, friction=self.friction)
         except LinkageError as exc:
             self.report.notes.append(f"dynamics: left out ({exc})")
             return
@@ -327,7 +370,7 @@ class _Work:
             links=_links(mech), pairs=_pairs(mech), scheme_text=dumps(mech), summary=summary,
             pictures=self.report.pictures, animation="animation.gif" if "animation.gif" in files else None,
             tables=tables, notes=self.report.notes, version=__version__, analogs=_analogs_words(mech),
-            kinematics_units=units_of(self.kinematics.columns) if self.kinematics else {})
+            kinematics_units=units_of(self.kinematics.columns) if self.kinematics else {}, friction=self.friction)
         self._write("index.html", html)
 
 
@@ -358,6 +401,8 @@ _RESULT_WORDS = {
     "exact_flywheel_inertia": ("flywheel inertia, exact energy method", "kg·m²"),
     "course_vs_exact_inertia": ("course / exact required inertia − 1", ""),
     "course_delta_exact": ("δ of the course flywheel, solved exactly", ""),
+    "friction_work": ("work lost to friction per cycle (trapezoid over the table positions)", "J"),
+    "cycle_efficiency": ("cycle efficiency 1 − A_friction / A_driving (same trapezoid)", ""),
 }
 
 

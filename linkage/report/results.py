@@ -304,7 +304,9 @@ def forces_results(mech: Mechanism, positions: int | None = None, start: str | f
         motion = analyze(mech, phi, order=2, omega=omega, eps=eps, on_failure="mask")
         ends = np.zeros(len(phi), bool)
         ends[-1] = True
-        reactions = solve_reactions(motion, ends=ends, friction=friction, sense=direction)
+        # a static analysis: the friction opposes the table's own travel (a slide's stroke may run down)
+        travel = direction if mech.coordinate.is_angle else (1 if phi[-1] >= phi[0] else -1)
+        reactions = solve_reactions(motion, ends=ends, friction=friction, sense=travel)
         residual = virtual_power_residual(reactions)
         cycle = friction_cycle(mech, omega, notes) if friction else None
     failed, lines = failures(motion)
@@ -321,7 +323,7 @@ def forces_results(mech: Mechanism, positions: int | None = None, start: str | f
         meta["self_locking_positions"] = [int(i) + 1 for i in np.flatnonzero(reactions.locked)]
         if motion.omega is None:
             notes.append("static analysis: the friction opposes the input's "
-                         f"{'increasing' if direction > 0 else 'decreasing'} coordinate; power_lost and K.power_lost "
+                         f"{'increasing' if travel > 0 else 'decreasing'} coordinate; power_lost and K.power_lost "
                          "are per unit of its speed (W per rad/s, i.e. N m; W per m/s for a slide input)")
         meta["cycle"] = cycle
     return TableResults(_friction_first(reactions.columns(full=True)), meta, motion, notes,
