@@ -80,9 +80,27 @@ def test_a_scheme_file_with_a_wrong_section_names_the_file(tmp_path):
 
 
 def test_the_builder_takes_the_section_too():
-    source = press()
-    built = source.with_extra(friction={"prismatic": {"f": 0.2}})
-    assert friction_of(built).pairs == {"slide": PairFriction("slide", "P", 0.2)}
+    """A four-bar built in Python with friction: its balancing moment grows by the friction
+    moments' virtual power (checked by the frictionless balance plus the losses)."""
+    from linkage.model import MechanismBuilder
+    b = MechanismBuilder("four_bar")
+    b.link("0", points={"O": (0.0, 0.0), "C": (0.3, 0.0)})
+    b.link("1", line=("O", "A"), length=0.1)
+    b.link("2", line=("A", "B"), length=0.3, mass=2.0, com="A")
+    b.link("3", line=("C", "B"), length=0.25)
+    for name, a, c in [("O", "0", "1"), ("A", "1", "2"), ("B", "2", "3"), ("C", "3", "0")]:
+        b.revolute(name, a, c)
+    b.inputs("1").assembly("B", left_of=("A", "C"))
+    mech = b.build(friction={"revolute": {"f": 0.1, "radius": 0.01}})
+    assert set(friction_of(mech).pairs) == {"O", "A", "B", "C"}
+    motion = linkage.analyze(mech, np.radians([20.0, 100.0, 250.0]), omega=5.0, eps=0.0)
+    with_friction, plain = solve_reactions(motion, friction=True), solve_reactions(motion)
+    lost = -with_friction.friction_power() / 5.0                 # N m per rad/s of crank speed
+    assert np.all(lost > 0)
+    # the frictionless loads' power is unchanged: M_b grows by exactly the friction's loss per unit speed
+    np.testing.assert_allclose(with_friction.balancing_moment - plain.balancing_moment, lost, rtol=1e-9)
+    with pytest.raises(SchemeError, match="pairs.Z"):
+        friction_of(b.build(friction={"pairs": {"Z": {"f": 0.1}}}))
 
 
 def test_friction_raises_the_driving_moment_and_the_flywheel_by_its_reduced_moment():
