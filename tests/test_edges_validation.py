@@ -292,7 +292,7 @@ def test_bad_dynamics_and_a_cycle_table_that_needs_it_are_one_message(tmp_path):
 
 def test_loads_and_dynamics_are_parsed_once_at_load_time(monkeypatch):
     mech = linkage.load("course_slider_crank")
-    assert set(mech.parts) == {"loads", "dynamics", "checks"}
+    assert set(mech.parts) == {"loads", "dynamics", "checks", "friction"}
     loads, spec = loads_of(mech), dynamics_of(mech)
     calls = []
     for section in ("loads", "dynamics"):

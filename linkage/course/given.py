@@ -55,9 +55,9 @@ GIVEN_FORMAT = "linkage given.json 1"
 #: rad/s per rpm
 RPM = 2 * math.pi / 60
 #: titles of the data table's sections, in the order printed
-GEOMETRY, MASSES, PAIRS, MOTION, LOADS, SPEED = (
+GEOMETRY, MASSES, PAIRS, MOTION, LOADS, SPEED, FRICTION = (
     "Links: dimensions", "Masses and moments of inertia", "Kinematic pairs", "Input, output and position 1",
-    "Loads", "Speed, flywheel and motor")
+    "Loads", "Speed, flywheel and motor", "Friction in the pairs")
 #: the section of what is graded and how
 GRADING = "What you report and how it is graded"
 #: the section of the template's parameters on a sheet
@@ -139,7 +139,7 @@ def _angle(spec: Mapping[str, Any], key: str) -> tuple[str, str, str] | None:
 class _Rows:
     """Sections of rows, in the order of :data:`_ORDER`."""
 
-    _ORDER = (GEOMETRY, MASSES, PAIRS, MOTION, LOADS, SPEED, FURTHER)
+    _ORDER = (GEOMETRY, MASSES, PAIRS, MOTION, LOADS, SPEED, FRICTION, FURTHER)
 
     def __init__(self):
         self.sections: dict[str, list[dict[str, Any]]] = {title: [] for title in self._ORDER}
@@ -427,6 +427,25 @@ _MOTOR_WORDS = {
 }
 
 
+def _friction_rows(rows: _Rows, scheme: Mapping[str, Any]) -> None:
+    """``[friction]``: the coefficients and radii per class of pairs and per pair."""
+    spec = scheme.get("friction")
+    if not isinstance(spec, Mapping):
+        return
+    words = {"f": ("coefficient of friction", "f", ""), "radius": ("journal radius (friction circle f·r)", "r", "m"),
+             "length": ("slider block length", "b", "m")}
+    entries = [(key, f"every {key} pair", spec[key]) for key in ("revolute", "prismatic")
+               if isinstance(spec.get(key), Mapping)]
+    entries += [(f"pairs.{name}", f"pair {name}", value) for name, value in (spec.get("pairs") or {}).items()
+                if isinstance(value, Mapping)]
+    for where, who, values in entries:
+        for key, value in values.items():
+            if key in words:
+                what, symbol, unit = words[key]
+                rows.add(FRICTION, f"{who}: {what}", _symbol(symbol, where.rpartition(".")[2] if "." in where else ""),
+                         number_text(value), unit, [f"friction.{where}.{key}"])
+
+
 def _speed_rows(rows: _Rows, scheme: Mapping[str, Any]) -> None:
     dyn = scheme.get("dynamics")
     if not isinstance(dyn, Mapping):
@@ -499,6 +518,7 @@ def data_sections(scheme: Mapping[str, Any], facts: Mapping[str, Any]) -> list[d
     _motion_rows(rows, scheme, facts)
     _load_rows(rows, scheme)
     _speed_rows(rows, scheme)
+    _friction_rows(rows, scheme)
     shown = {src for section in rows.sections.values() for row in section for src in row["from"]}
     shown |= {src for d in load_diagrams(scheme) for row in _diagram_table_rows(d) for src in row["from"]}
     for path, value in scheme_leaves(scheme).items():
