@@ -418,7 +418,7 @@ class Mechanism:
         pair = self.pairs.get(self.input_pair(name) or "")
         return "slide" if isinstance(pair, Prismatic) else "angle"
 
-    @property
+    @cached_property
     def coordinate(self) -> InputCoordinate:
         """The first input's coordinate (an angle or a slide): what ``phi`` holds."""
         return InputCoordinate(self.input_kind(self.inputs[0]) if self.inputs else "angle")
