@@ -376,10 +376,10 @@ def _scan(g: _Geometry, phi: float, theta: np.ndarray):
     r1, r2 = g.legs[i].length, g.legs[j].length
     d = c2 - c1
     L = np.hypot(d[:, 0], d[:, 1])
-    along = (L**2 + r1**2 - r2**2) / (2 * L)
-    with np.errstate(invalid="ignore"):
+    with np.errstate(invalid="ignore", divide="ignore"):     # L = 0 (coincident anchors): NaN, no root there
+        along = (L**2 + r1**2 - r2**2) / (2 * L)
         h = np.sqrt(r1**2 - along**2)
-    u = d / L[:, None]
+        u = d / L[:, None]
     n = np.stack([-u[:, 1], u[:, 0]], axis=-1)
     foot = c1 + along[:, None] * u
     origins = np.stack([foot + h[:, None] * n, foot - h[:, None] * n])
