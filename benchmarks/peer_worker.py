@@ -3,15 +3,18 @@
 Run by ``benchmarks/run.py`` with the python of a venv that holds pylinkage (with or without
 numba), never imported by the project. It talks one JSON object a line:
 
-- argv: ``--reference PATH`` (an ``.npz`` written by run.py: ``phi`` (N,) uniform from 0, our
-  ``A``, ``B``, ``E`` (N, 2) positions, m, and their first / second analogs ``dA``, ``ddA``...);
-- first line written: ``{"ready": ..., "numba": bool, "check": {...}}`` with the largest
-  differences between pylinkage's results and ours (positions, velocities, accelerations);
-- then for each line read, ``{"task": "kinematics" | "positions" | "kinematics_points"}``, the
-  task is run once and ``{"task": ..., "seconds": s}`` is written; ``{"task": "quit"}`` ends.
+- argv: ``--reference PATH``, once per number of positions N (an ``.npz`` written by run.py:
+  ``phi`` (N,) uniform from 0, our ``A``, ``B``, ``E`` (N, 2) positions, m, and their first /
+  second analogs ``dA``, ``ddA``...);
+- first line written: ``{"ready": ..., "numba": bool, "check": {"N": {...}}}`` with, per N, the
+  largest differences between pylinkage's results and ours (positions, velocities, accelerations);
+- then for each line read, ``{"task": "kinematics" | "positions" | "kinematics_points", "n": N,
+  "calls": k}``, the task is run k times at N positions and ``{"task": ..., "seconds": s}`` is
+  written, s the mean duration of one call; ``{"task": "quit"}`` ends.
 
 Run.py keeps this process alive for the whole benchmark and asks for one run per paired round,
-so a peer's run and ours in the same round see the same machine load.
+so a peer's run and ours in the same round see the same machine load; at small N a run is many
+calls (one call at N = 12 takes microseconds), timed together and divided.
 
 What pylinkage computes (its own API, ``simulation.Linkage``):
 
@@ -143,12 +146,14 @@ class Peer:
         self.linkage.set_coords(self.start)
         return self.linkage.step_fast(iterations=self.n)
 
-    def timed(self, task: str) -> float:
+    def timed(self, task: str, calls: int = 1) -> float:
+        """The mean duration of ``calls`` calls of ``task`` timed together, s."""
         fn = {"kinematics": self.kinematics, "positions": self.positions,
               "kinematics_points": self.kinematics_points}[task]
         t0 = time.perf_counter()
-        fn()
-        return time.perf_counter() - t0
+        for _ in range(calls):
+            fn()
+        return (time.perf_counter() - t0) / calls
 
 
 def largest_difference(ours: np.ndarray, theirs: np.ndarray) -> float:
@@ -176,13 +181,13 @@ def phi_is_uniform(phi: np.ndarray) -> bool:
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--reference", required=True, help="npz with phi, A, B, E, dA, ... (run.py writes it)")
+    parser.add_argument("--reference", required=True, action="append",
+                        help="npz with phi, A, B, E, dA, ... (run.py writes it), once per N")
     parser.add_argument("--plain-path", choices=("auto", "fast", "generator"), default="auto",
                         help="which pylinkage path gives full kinematics without numba (with numba: fast)")
     args = parser.parse_args(argv)
-    ref = np.load(args.reference)
-    phi = ref["phi"]
-    if not phi_is_uniform(phi):
+    refs = [np.load(path) for path in args.reference]
+    if not all(phi_is_uniform(ref["phi"]) for ref in refs):
         print(json.dumps({"error": "phi must be 2 pi k / N, k = 0..N-1 (pylinkage steps the crank uniformly)"}))
         return 2
     from pylinkage._numba_compat import HAS_NUMBA
@@ -192,21 +197,33 @@ def main(argv: list[str] | None = None) -> int:
     if path == "auto":
         path_times = {p: Peer(2000, p).timed("kinematics_points") for p in ("fast", "generator")}
         path = min(path_times, key=path_times.get)
-    peer = Peer(len(phi), path)
     t0 = time.perf_counter()
-    agreement = check(peer, ref)                       # also compiles (numba) and warms the caches
+    peers, agreement = {}, {}
+    for ref in refs:
+        n = len(ref["phi"])
+        peers[n] = Peer(n, path)
+        agreement[str(n)] = check(peers[n], ref)           # also compiles (numba) and warms the caches
     warm = time.perf_counter() - t0
     import pylinkage
 
-    print(json.dumps({"ready": True, "numba": HAS_NUMBA, "pylinkage": pylinkage.__version__,
-                      "numpy": np.__version__, "path": peer.plain_path, "path_times_2000_s": path_times,
-                      "check": agreement,
-                      "warmup_s": warm}), flush=True)
+    numba_version = None
+    if HAS_NUMBA:
+        import numba
+        numba_version = numba.__version__
+    print(json.dumps({"ready": True, "numba": HAS_NUMBA, "numba_version": numba_version,
+                      "pylinkage": pylinkage.__version__, "numpy": np.__version__, "path": path,
+                      "path_times_2000_s": path_times, "check": agreement, "warmup_s": warm}), flush=True)
     for line in sys.stdin:
-        task = json.loads(line).get("task")
+        request = json.loads(line)
+        task = request.get("task")
         if task == "quit":
             break
-        print(json.dumps({"task": task, "seconds": peer.timed(task)}), flush=True)
+        n = int(request["n"])
+        if n not in peers:
+            print(json.dumps({"error": f"no reference for N = {n} (have {sorted(peers)})"}), flush=True)
+            continue
+        seconds = peers[n].timed(task, int(request.get("calls", 1)))
+        print(json.dumps({"task": task, "n": n, "seconds": seconds}), flush=True)
     return 0
 
 

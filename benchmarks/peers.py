@@ -106,16 +106,19 @@ class PeerWorker:
     ----------
     python : Path
         The python of the peer's venv.
-    reference : Path
-        The ``.npz`` of our reference results (see ``peer_worker.py``).
+    references : list of Path
+        The ``.npz`` of our reference results, one per number of positions N (see ``peer_worker.py``).
     env : dict
         Environment of the process (``OMP_NUM_THREADS=1`` ...).
     """
 
-    def __init__(self, python: Path, reference: Path, env: dict) -> None:
-        self.stderr_path = reference.with_name(f"{Path(python).parent.parent.name}.stderr")
+    def __init__(self, python: Path, references: list[Path], env: dict) -> None:
+        self.stderr_path = references[0].with_name(f"{Path(python).parent.parent.name}.stderr")
         self._stderr = open(self.stderr_path, "w")  # noqa: SIM115 - open for the process's lifetime
-        self.process = subprocess.Popen([str(python), str(WORKER), "--reference", str(reference)],
+        argv = [str(python), str(WORKER)]
+        for reference in references:
+            argv += ["--reference", str(reference)]
+        self.process = subprocess.Popen(argv,
                                         stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=self._stderr,
                                         text=True, env=env, cwd=str(BENCH_DIR))
         self._lines: queue.Queue = queue.Queue()
@@ -147,9 +150,10 @@ class PeerWorker:
         self.info = self._reply(timeout)
         return self.info
 
-    def seconds(self, task: str, timeout: float = 900.0) -> float:
-        """Run ``task`` once in the worker; its duration measured there, s."""
-        self.process.stdin.write(json.dumps({"task": task}) + "\n")
+    def seconds(self, task: str, n: int, calls: int = 1, timeout: float = 900.0) -> float:
+        """Run ``task`` ``calls`` times at ``n`` positions in the worker; the mean duration of one
+        call measured there, s."""
+        self.process.stdin.write(json.dumps({"task": task, "n": n, "calls": calls}) + "\n")
         self.process.stdin.flush()
         return float(self._reply(timeout)["seconds"])
 

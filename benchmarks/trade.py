@@ -1,7 +1,7 @@
 """The speed/accuracy trade of the library, measured: what each choice costs and what it buys.
 
 Run ``python benchmarks/trade.py`` (the full run, about a minute on 2 cores) or
-``python benchmarks/trade.py --quick`` (about 25 s); ``--out FILE`` writes the markdown there
+``python benchmarks/trade.py --quick`` (about 40 s); ``--out FILE`` writes the markdown there
 instead of printing it. ``python benchmarks/run.py --quick`` calls :func:`run` and appends its
 lines to ``benchmarks/RESULTS.md``. Every study also writes one picture,
 ``docs/images/trade_<study>.png``; ``docs/speed_accuracy.md`` explains the figures.
@@ -54,6 +54,7 @@ from linkage.dynamics.reduced import reduced_characteristics
 
 __all__ = [
     "AnalogRow",
+    "InputSweep",
     "MethodsResult",
     "NewtonResult",
     "PositionsRow",
@@ -61,6 +62,7 @@ __all__ = [
     "adaptive_cycle_work",
     "analog_study",
     "dynamics_schemes",
+    "input_sweep",
     "main",
     "methods_study",
     "newton_schemes",
@@ -1023,7 +1025,8 @@ def newton_lines(results: Sequence[NewtonResult], image: str) -> list[str]:
     """The markdown of the Newton study (:func:`newton_study`); ``image``: the picture's path."""
     call = ", ".join(sorted({r.closed_call for r in results}))
     lines = ["## 5. Closed form vs Newton's method on the same group", "",
-             (f"Each dyad kind of the shipped schemes at {NEWTON_POSITIONS} positions of a turn. Closed form: the "
+             (f"Each dyad kind of the shipped schemes at {NEWTON_POSITIONS} positions of a turn (of the stroke for a "
+             "slide input). Closed form: the "
              f"library's `{call}` as `linkage.analyze` calls it (positions only, vectorised, with its closure "
              "and conditioning checks). Newton: "
              "`Φ_q Δq = −Φ` on the group's constraint equations until the step is below 1e-12 (of the "
@@ -1096,19 +1099,60 @@ def newton_figure(results: Sequence[NewtonResult], path: Path | None) -> None:
 @dataclass(frozen=True)
 class AnalogRow:
     """The largest differences of the exact first and second analogs of every column of a
-    scheme's table from 5-point finite differences with step ``h`` (rad), relative to the
-    mechanism's size (angles: in rad)."""
+    scheme's table from 5-point finite differences with step ``h``, relative to the mechanism's
+    size (angles: in rad).
+
+    ``h`` is in rad of a crank; for a slide input it is in rad of the equivalent turn (the stroke
+    is one turn, :class:`InputSweep`): the step is then ``h * scale`` m and the analogs are taken
+    per rad of that turn, so the rows of every scheme compare.
+    """
 
     scheme: str
     h: float
     first: float
     second: float
+    slide: bool = False
 
 
-def _finite_differences(mech: linkage.Mechanism, phi: np.ndarray, h: float, exact: dict[str, np.ndarray]) -> tuple[float, float]:
+@dataclass(frozen=True)
+class InputSweep:
+    """The input values a study runs over and the unit of its steps.
+
+    ``values`` (rad for a crank, m for a slide), ``scale`` the input's units per rad of a turn:
+    1 for a crank; for a slide, its declared stroke (``mech.input_range``, m) over 2 pi, so that
+    a step ``h`` (rad) moves the slide by ``h * scale`` m and the stroke is one turn.
+    """
+
+    values: np.ndarray
+    scale: float
+    slide: bool
+    words: str
+
+
+def input_sweep(mech: linkage.Mechanism, positions: int, margin: float = 0.0) -> InputSweep:
+    """``positions`` values of the input over a turn of a crank (from 0.1 rad), over its declared
+    input range, or over a slide's declared stroke (m), inside the range or stroke by ``margin``
+    (rad of a turn: ``margin * scale`` m for a slide); :class:`InputSweep`."""
+    if mech.input_range is None:
+        return InputSweep(np.linspace(0.1, 0.1 + 2 * np.pi, positions, endpoint=False), 1.0, False, "a turn")
+    a, b = sorted(float(v) for v in mech.input_range)
+    slide = not mech.coordinate.is_angle
+    scale = (b - a) / (2 * np.pi) if slide else 1.0
+    if b - a <= 2 * margin * scale:
+        raise SchemeError(f"mechanism '{mech.name}': its input range [{a:.6g}, {b:.6g}] is narrower than twice the "
+                          f"finite-difference margin {margin * scale:.6g}")
+    words = f"the stroke {a:.4g}–{b:.4g} m" if slide else f"the range {a:.4g}–{b:.4g} rad"
+    return InputSweep(np.linspace(a + margin * scale, b - margin * scale, positions), scale, slide, words)
+
+
+def _finite_differences(mech: linkage.Mechanism, sweep: InputSweep, h: float,
+                        exact: dict[str, np.ndarray]) -> tuple[float, float]:
+    """The largest differences of the first and second analogs (per rad of the sweep's turn) from
+    5-point finite differences with step ``h`` (rad of the turn), relative to the size."""
+    step = h * sweep.scale                             # rad, or m for a slide
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", BranchWarning)
-        shifted = {k: linkage.analyze(mech, phi + k * h, order=0).columns() for k in (-2, -1, 1, 2)}
+        shifted = {k: linkage.analyze(mech, sweep.values + k * step, order=0).columns() for k in (-2, -1, 1, 2)}
     e1 = e2 = 0.0
     for col, value in exact.items():
         if col.endswith("'") or col in ("i", "phi_deg") or col + "'" not in exact:
@@ -1116,48 +1160,49 @@ def _finite_differences(mech: linkage.Mechanism, phi: np.ndarray, h: float, exac
         f = {k: shifted[k][col] for k in shifted}
         if col.endswith("theta"):
             f = {k: value + np.angle(np.exp(1j * (v - value))) for k, v in f.items()}
-        d1 = (f[-2] - 8 * f[-1] + 8 * f[1] - f[2]) / (12 * h)
-        d2 = (-f[-2] + 16 * f[-1] - 30 * value + 16 * f[1] - f[2]) / (12 * h * h)
+        d1 = (f[-2] - 8 * f[-1] + 8 * f[1] - f[2]) / (12 * step)
+        d2 = (-f[-2] + 16 * f[-1] - 30 * value + 16 * f[1] - f[2]) / (12 * step * step)
         size = 1.0 if col.endswith("theta") else mech.size
-        e1 = max(e1, float(np.max(np.abs(d1 - exact[col + "'"]))) / size)
-        e2 = max(e2, float(np.max(np.abs(d2 - exact[col + "''"]))) / size)
+        e1 = max(e1, float(np.max(np.abs(d1 - exact[col + "'"]))) * sweep.scale / size)
+        e2 = max(e2, float(np.max(np.abs(d2 - exact[col + "''"]))) * sweep.scale ** 2 / size)
     return e1, e2
 
 
 def analog_study(names: Sequence[str] | None = None, steps: Sequence[float] = STEPS,
                  positions: int = 36) -> list[AnalogRow]:
     """:class:`AnalogRow` for every scheme of ``names`` (default: the shipped ones) and step of ``steps``,
-    at ``positions`` angles of a turn (of the input range, inside it by 3 of the largest steps)."""
+    at ``positions`` values of the input (:func:`input_sweep`: a turn of a crank, its input range,
+    or a slide's stroke, inside the range or stroke by 3 of the largest steps)."""
     rows = []
     for name in names or linkage.shipped_schemes():
         mech = linkage.load(name)
-        if mech.input_range is None:
-            phi = np.linspace(0.1, 0.1 + 2 * np.pi, positions, endpoint=False)
-        else:
-            a, b = sorted(mech.input_range)
-            margin = 3 * max(steps)
-            phi = np.linspace(a + margin, b - margin, positions)
+        sweep = input_sweep(mech, positions, margin=3 * max(steps))
         with warnings.catch_warnings():  # the positions are far apart and analysed each on its own: the
             warnings.simplefilter("ignore", BranchWarning)  # check of continuity between them does not apply
-            exact = linkage.analyze(mech, phi).columns()
+            exact = linkage.analyze(mech, sweep.values).columns()
         for h in steps:
-            rows.append(AnalogRow(name, h, *_finite_differences(mech, phi, h, exact)))
+            rows.append(AnalogRow(name, h, *_finite_differences(mech, sweep, h, exact), slide=sweep.slide))
     return rows
 
 
 def analog_lines(rows: Sequence[AnalogRow], image: str, h: float = 1e-3) -> list[str]:
     """The markdown of the analogs study (:func:`analog_study`); ``image``: the picture's path."""
+    slides = [name for name in dict.fromkeys(r.scheme for r in rows if r.slide)]
     lines = ["## 6. Exact analogs vs 5-point finite differences", "",
              ("Largest difference over 36 positions and every column of `linkage analyze` (points, angles, "
              "slides), relative to the mechanism's size (angles in rad), at the step h = 1e-3 rad and at the "
-             "step where it is smallest."), ""]
+             "step where it is smallest. Every shipped scheme: a crank over a turn (or its declared range), "
+             + (f"a slide input ({', '.join(slides)}; marked *slide*) over its declared stroke in metres: the "
+                "stroke counts as one turn, so its step is h × stroke / 2π m and its analogs are taken per rad "
+                "of that turn (the rows compare)." if slides else "a slide input over its declared stroke.")),
+             ""]
     table = []
     for name in dict.fromkeys(r.scheme for r in rows):
         mine = [r for r in rows if r.scheme == name]
         at = min(mine, key=lambda r: abs(math.log(r.h / h)))
         best1, best2 = min(mine, key=lambda r: r.first), min(mine, key=lambda r: r.second)
-        table.append([name, f"{at.first:.1e}", f"{at.second:.1e}", f"{best1.first:.1e} (h = {best1.h:g})",
-                      f"{best2.second:.1e} (h = {best2.h:g})"])
+        table.append([name + (" (*slide*)" if mine[0].slide else ""), f"{at.first:.1e}", f"{at.second:.1e}",
+                      f"{best1.first:.1e} (h = {best1.h:g})", f"{best2.second:.1e} (h = {best2.h:g})"])
     lines += _table(["scheme", "q' at h = 1e-3", "q'' at h = 1e-3", "q' smallest", "q'' smallest"], table)
     lines += ["", ("The differences follow the finite differences' own error, truncation ∝ h⁴ for large h and "
                   "rounding ∝ ε/h (first) and ε/h² (second) for small h: none of it is an error of the exact analogs."),
@@ -1215,7 +1260,7 @@ def run(quick: bool = True, *, images: Path | None = IMAGES) -> list[str]:
     Parameters
     ----------
     quick : bool
-        Fewer repeats for the times and a looser reference for the ODE tolerances (about 25 s on a
+        Fewer repeats for the times and a looser reference for the ODE tolerances (about 40 s on a
         2-core machine instead of about a minute).
     images : Path or None
         Folder of the pictures ``trade_<study>.png`` (default ``docs/images``); None draws none.
@@ -1262,7 +1307,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     """``python benchmarks/trade.py [--quick] [--out FILE] [--no-images]``."""
     parser = argparse.ArgumentParser(description="Measure the speed/accuracy trade of the library (tables in "
                                                  "markdown, pictures docs/images/trade_*.png).")
-    parser.add_argument("--quick", action="store_true", help="fewer repeats, looser ODE reference (about 25 s)")
+    parser.add_argument("--quick", action="store_true", help="fewer repeats, looser ODE reference (about 40 s)")
     parser.add_argument("--out", type=Path, help="write the markdown to this file instead of printing it")
     parser.add_argument("--no-images", action="store_true", help="draw no pictures")
     args = parser.parse_args(argv)
