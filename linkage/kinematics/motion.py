@@ -38,6 +38,7 @@ from ..model.mechanism import Mechanism, Prismatic
 from ..structure import Structure, structure_of
 from .assembly import assembly_plans, place_group
 from .inputs import input_state
+from .kernel import run_kernel
 
 __all__ = ["Motion", "analyze", "input_sweep", "SWEEP", "BranchWarning",
            "parse_quantity", "table_positions_deg", "angle_in_half_turn", "position_column"]
@@ -361,7 +362,9 @@ def analyze(
     plans = assembly_plans(mech)
     group_ids = range(len(structure.groups)) if outputs is None else \
         structure.needed_groups(links_needed(mech, outputs))
-    run = run_blocks(mech, structure, plans, list(group_ids), phi, order)
+    run = _kernel_run(mech, phi, order) if outputs is None else None
+    if run is None:
+        run = run_blocks(mech, structure, plans, list(group_ids), phi, order)
     for i in group_ids:
         group = structure.groups[i]
         _check_continuity(group, run.signs[i], plans[i].branches(phi), run.solved[i], phi, mech.coordinate)
@@ -379,6 +382,18 @@ def analyze(
     return Motion(mech, structure, phi, poses, first if order >= 1 else None,
                   second if order >= 2 else None, status, omega_arr, eps_arr, run.conditioning,
                   run.error_bound)
+
+
+def _kernel_run(mech: Mechanism, phi: np.ndarray, order: int) -> _Run | None:
+    """:func:`run_blocks` of every group by the mechanism's compiled kernel
+    (:mod:`linkage.kinematics.kernel`: the same numbers), None where it does not apply."""
+    if not USE_KERNEL or not len(phi):
+        return None
+    got = run_kernel(mech, phi, order)
+    if got is None:
+        return None
+    return _Run(got["poses"], got["first"], got["second"], got["status"], got["conditioning"],
+                got["error_bound"], got["signs"], got["solved"])
 
 
 def _check_law_domains(mech: Mechanism, phi: np.ndarray) -> None:
@@ -426,6 +441,9 @@ def links_needed(mech: Mechanism, outputs: Iterable[str]) -> list[str]:
 #: positions solved at a time: the temporaries of a block stay in the processor's cache and the
 #: memory of a call stays bounded (the result plus a few blocks)
 BLOCK = 8192
+#: solve a mechanism of closed-form dyads by its compiled kernel (:mod:`.kernel`; the same numbers,
+#: bit for bit); False: always the general path (the oracle the kernel is tested against)
+USE_KERNEL = True
 
 
 @dataclass
