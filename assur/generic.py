@@ -19,8 +19,10 @@ from __future__ import annotations
 import numpy as np
 
 from .base import CANNOT_ASSEMBLE, NOT_CONVERGED, OK, SINGULAR, Group, GroupPosition, Poses
+from .fused import layout_of
 
-__all__ = ["NewtonGroup", "NEWTON_STEPS", "TRACE_JUMP", "GROUP_ROUNDOFF_FACTOR", "newton", "group_class_of"]
+__all__ = ["NewtonGroup", "NEWTON_STEPS", "TRACE_JUMP", "GROUP_ROUNDOFF_FACTOR", "newton", "newton_pairwise",
+           "group_class_of"]
 
 #: most Newton steps per solve
 NEWTON_STEPS = 40
@@ -36,6 +38,14 @@ TRACE_JUMP = 0.1
 #: rad from singular) against 50-digit references (benchmarks/bench_guarantee_groups.py, results in
 #: benchmarks/results_guarantee_groups.md); about ten times that for a margin
 GROUP_ROUNDOFF_FACTOR = 0.6
+
+try:        # the batched solve np.linalg.solve calls, without its checks (singular systems give NaN)
+    from numpy.linalg import _umath_linalg
+
+    def _SOLVE(a, b):
+        return _umath_linalg.solve1(a, b, signature="dd->d")
+except (ImportError, AttributeError):       # pragma: no cover - another numpy
+    _SOLVE = None
 
 
 def group_class_of(links, joints) -> str:
@@ -70,6 +80,10 @@ def _roman(n: int) -> str:
 def newton(group: Group, poses: Poses, start: Poses, steps: int | None = None):
     """Newton's method on ``group``'s constraints from the ``start`` poses of its links.
 
+    Each iteration evaluates the whole residual and group Jacobian at once with the group's
+    :class:`assur.fused.FusedLayout`; where the group has none (or with :data:`assur.fused.FUSED`
+    off) pair by pair (:func:`newton_pairwise`: the same numbers).
+
     Parameters
     ----------
     poses : dict of link -> ndarray (N, 3)
@@ -86,6 +100,56 @@ def newton(group: Group, poses: Poses, start: Poses, steps: int | None = None):
     converged : ndarray of bool (N,)
         Where the last step was below ``STEP_TOL`` times the size (rad for angles).
     """
+    layout = layout_of(group)
+    if layout is None:
+        return newton_pairwise(group, poses, start, steps)
+    links = group.links
+    steps = NEWTON_STEPS if steps is None else steps
+    q = np.concatenate([np.asarray(start[k], float) for k in links], axis=1)
+    N, width = q.shape
+    known_links = layout.order[len(links):]
+    known = np.broadcast_to(layout.stack(poses, known_links), (N, len(known_links), 3)) if known_links \
+        else np.zeros((N, 0, 3))
+    converged = np.zeros(N, bool)
+    limit, unit, positive = layout.damping(group.size, N)
+    rows = np.flatnonzero(np.isfinite(q).all(axis=1))       # the positions still iterated
+    for _ in range(steps if len(rows) else 0):
+        every = len(rows) == N
+        at = slice(None) if every else rows
+        here = q if every else q[rows]
+        residual, full = layout.evaluate(np.concatenate([here.reshape(len(rows), -1, 3), known[at]], axis=1))
+        step, solvable = _solve_regular(full[:, :, :width], -residual)
+        scale = limit if limit.ndim == 1 else limit[at]
+        if solvable is True and positive:
+            # every system solved, every step finite: the damping of newton_pairwise in fewer calls
+            factor = (scale / np.maximum(np.abs(step), scale)).min(axis=1)
+            step *= factor[:, None]
+            here += step
+            done = ((np.abs(step) / (unit if unit.ndim == 1 else unit[at])).max(axis=1) <= STEP_TOL) & (factor == 1.0)
+            stop = done if np.isfinite(here).all() else done | ~np.isfinite(here).all(axis=1)
+        else:
+            solvable = np.ones(len(rows), bool) if solvable is True else solvable
+            with np.errstate(invalid="ignore", divide="ignore"):
+                factor = np.min(np.where(np.abs(step) > scale, scale / np.abs(step), 1.0), axis=1)
+            step *= factor[:, None]
+            here += np.where(solvable[:, None], step, 0.0)
+            small = np.max(np.abs(step) / (unit if unit.ndim == 1 else unit[at]), axis=1) <= STEP_TOL
+            done = solvable & small & (factor == 1.0)
+            stop = done | ~solvable | ~np.all(np.isfinite(here), axis=1)
+        if not every:
+            q[rows] = here
+        if stop.any():
+            converged[rows[done]] = True
+            rows = rows[~stop]
+            if not len(rows):
+                break
+    return _split(q, links), converged
+
+
+def newton_pairwise(group: Group, poses: Poses, start: Poses, steps: int | None = None):
+    """:func:`newton` with the residual and Jacobian assembled pair by pair
+    (:meth:`Group.jacobians`): the reference of the fused path, and the path of a group whose
+    pairs :mod:`assur.fused` does not know."""
     links = group.links
     steps = NEWTON_STEPS if steps is None else steps
     q = np.concatenate([np.asarray(start[k], float) for k in links], axis=1).copy()
@@ -114,6 +178,19 @@ def newton(group: Group, poses: Poses, start: Poses, steps: int | None = None):
         converged[rows[done]] = True
         active[rows[done | ~solvable | ~np.all(np.isfinite(q[rows]), axis=1)]] = False
     return _split(q, links), converged
+
+
+def _solve_regular(a: np.ndarray, b: np.ndarray):
+    """:func:`_solve` where every system is finite and regular, ``(x, True)``; else :func:`_solve`."""
+    if np.isfinite(b).all() and np.isfinite(a).all():
+        try:
+            with np.errstate(invalid="ignore", over="ignore", divide="ignore", under="ignore"):
+                x = _SOLVE(a, b) if _SOLVE is not None else np.linalg.solve(a, b[..., None])[..., 0]
+        except np.linalg.LinAlgError:
+            x = None
+        if x is not None and np.isfinite(x).all():
+            return x, True
+    return _solve(a, b)
 
 
 def _solve(a: np.ndarray, b: np.ndarray):
@@ -158,6 +235,17 @@ class NewtonGroup(Group):
 
     def __repr__(self) -> str:
         return f"{self.group_class}({','.join(sorted(self.links, key=_natural))})"
+
+    def residual(self, poses: Poses) -> np.ndarray:
+        """:meth:`Group.residual` ``(N, m)``, evaluated fused (:mod:`assur.fused`)."""
+        layout = layout_of(self)
+        return super().residual(poses) if layout is None else layout.residual(poses, self.size)
+
+    def jacobians(self, poses: Poses) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+        """:meth:`Group.jacobians` (``Phi_q`` ``(N, m, m)``, known links' blocks ``(N, m, 3)``),
+        evaluated fused (:mod:`assur.fused`)."""
+        layout = layout_of(self)
+        return super().jacobians(poses) if layout is None else layout.jacobians(poses)
 
     def conditioning(self, phi_q: np.ndarray, poses: Poses) -> tuple[np.ndarray, np.ndarray]:
         """The group's distance to a singular position, scale-free, and the sign of its Jacobian's
