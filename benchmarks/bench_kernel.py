@@ -4,13 +4,18 @@ Run from the repository root::
 
     python benchmarks/bench_kernel.py            # 9 paired rounds per N, about a minute
     python benchmarks/bench_kernel.py --rounds 5
+    python benchmarks/bench_kernel.py --compile-times   # numba: compile in a first process, load in a second
 
 Contenders, the four-bar of ``schemes/four_bar.toml``, full kinematics (poses, first and second
 analogs, statuses, conditioning, error bounds) at N = 12, 360, 10,000 and 100,000 input angles:
 
-- **general**: ``linkage.analyze(mech, phi, order=2, on_failure="mask")`` (``run_blocks`` and
-  each group's ``Dyad.solve``, plus the continuity and jump checks);
-- **kernel**: ``run_kernel(mech, phi, 2)`` (linkage/kinematics/kernel.py, warm: compiled once);
+- **general**: ``linkage.analyze(mech, phi, order=2, on_failure="mask")`` with the kernel off
+  (``motion.USE_KERNEL = False``: ``run_blocks`` and each group's ``Dyad.solve``, plus the
+  continuity and jump checks);
+- **kernel**: ``run_kernel(mech, phi, 2)`` (linkage/kinematics/kernel.py, warm: compiled once;
+  the numpy kernel: ``LINKAGE_NUMBA=0`` in this process);
+- **numba kernel**: the same kernel written as one numba loop (linkage/kinematics/kernel_numba.py,
+  the ``fast`` extra; compiled before timing; skipped where numba is not installed);
 - **kernel + points**: the kernel, then the points A, B, E and their analogs from its poses
   (what the hand-fused kernel gives, without statuses or error bounds);
 - **hand-fused**: ``benchmarks/handfused.py`` ``fourbar_kinematics`` (A, B, E and the link angles
@@ -27,12 +32,15 @@ import os
 
 for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ[_var] = "1"
+os.environ["LINKAGE_NUMBA"] = "0"      # run_kernel and analyze: the numpy kernel (the numba one is its own contender)
 
 import argparse
 import datetime
 import platform
 import statistics
+import subprocess
 import sys
+import tempfile
 import time
 import warnings
 from pathlib import Path
@@ -47,8 +55,11 @@ import handfused  # noqa: E402
 
 import linkage  # noqa: E402
 from assur.base import point_analogs  # noqa: E402
-from linkage.kinematics.kernel import kernel_source, run_kernel  # noqa: E402
+import linkage.kinematics.motion as motion  # noqa: E402
+from linkage.kinematics.kernel import Kernel, kernel_source, run_kernel  # noqa: E402
+from linkage.kinematics.kernel_numba import TieredKernel  # noqa: E402
 from linkage.kinematics.motion import BranchWarning  # noqa: E402
+from linkage.structure import structure_of  # noqa: E402
 
 SIZES = (12, 360, 10_000, 100_000)
 POINTS = ("A", "B", "E")
@@ -64,13 +75,28 @@ def cpu_model() -> str:
     return platform.processor() or "unknown"
 
 
-def contenders(mech, phi):
+def numba_kernel(mech):
+    """The four-bar's kernel on numba (compiled now), or None where numba is not installed."""
+    os.environ["LINKAGE_NUMBA"] = "1"
+    try:
+        kernel = Kernel(mech, structure_of(mech), 2)
+        fn = kernel.function(kernel.branches(np.zeros(1)))[0]
+    finally:
+        os.environ["LINKAGE_NUMBA"] = "0"
+    return kernel if isinstance(fn, TieredKernel) and fn.compile() else None
+
+
+def contenders(mech, phi, fast=None):
     L = mech.links
     geo = {"OA": L["1"].points["A"][0], "AB": L["2"].points["B"][0], "CB": L["3"].points["B"][0],
            "C": tuple(L["0"].points["C"]), "E_local": tuple(L["2"].points["E"])}
 
     def general():
-        return linkage.analyze(mech, phi, order=2, on_failure="mask")
+        motion.USE_KERNEL = False
+        try:
+            return linkage.analyze(mech, phi, order=2, on_failure="mask")
+        finally:
+            motion.USE_KERNEL = True
 
     def kernel():
         return run_kernel(mech, phi, 2)
@@ -90,7 +116,10 @@ def contenders(mech, phi):
     def hand():
         return handfused.fourbar_kinematics(phi, **geo)
 
-    return {"general": general, "kernel": kernel, "kernel + points": kernel_points, "hand-fused": hand}
+    got = {"general": general, "kernel": kernel, "kernel + points": kernel_points, "hand-fused": hand}
+    if fast is not None:
+        got["numba kernel"] = lambda: fast(phi)
+    return got
 
 
 def per_call(fn, budget=0.02) -> float:
@@ -106,10 +135,11 @@ def per_call(fn, budget=0.02) -> float:
 
 def measure(rounds: int) -> dict:
     mech = linkage.load("four_bar")
+    fast = numba_kernel(mech)
     out = {}
     for n in SIZES:
         phi = np.linspace(0.0, 2.0 * np.pi, n, endpoint=False)
-        fns = contenders(mech, phi)
+        fns = contenders(mech, phi, fast)
         for fn in fns.values():           # warm-up: compile the kernel, fill the caches
             fn()
         names = list(fns)
@@ -123,6 +153,9 @@ def measure(rounds: int) -> dict:
             "kernel / hand-fused": [k / h for k, h in zip(times["kernel"], times["hand-fused"])],
             "(kernel + points) / hand-fused": [k / h for k, h in zip(times["kernel + points"], times["hand-fused"])],
         }
+        if "numba kernel" in times:
+            ratios["kernel / numba"] = [k / f for k, f in zip(times["kernel"], times["numba kernel"])]
+            ratios["numba / hand-fused"] = [f / h for f, h in zip(times["numba kernel"], times["hand-fused"])]
         out[n] = ({k: statistics.median(v) for k, v in times.items()},
                   {k: statistics.median(v) for k, v in ratios.items()})
         print(f"N = {n}: " + ", ".join(f"{k} {v * 1e3:.3f} ms" for k, v in out[n][0].items())
@@ -130,7 +163,40 @@ def measure(rounds: int) -> dict:
     return out
 
 
-def write(results: dict, rounds: int, path: Path) -> None:
+_COMPILE_SCRIPT = """
+import time
+start = time.perf_counter()
+import numpy as np, linkage, numba
+from linkage.kinematics.kernel import kernel_for
+mech = linkage.load("four_bar")
+kernel = kernel_for(mech, 2)
+ready = time.perf_counter()
+kernel(np.linspace(0.0, 1.0, 12))
+done = time.perf_counter()
+assert kernel.function(kernel.branches(np.zeros(1)))[0].jitted is not None
+print(ready - start, done - ready)
+"""
+
+
+def compile_times(runs: int = 3) -> list[tuple[float, float]] | None:
+    """(imports, first kernel call) seconds of fresh processes sharing one empty kernel cache: the
+    first compiles the four-bar's numba kernel, the next ones load it (None without numba)."""
+    try:
+        import numba  # noqa: F401
+    except ImportError:
+        return None
+    with tempfile.TemporaryDirectory() as cache:
+        env = {**os.environ, "LINKAGE_NUMBA": "1", "LINKAGE_CACHE_DIR": cache}
+        out = []
+        for _ in range(runs):
+            done = subprocess.run([sys.executable, "-c", _COMPILE_SCRIPT], capture_output=True, text=True, env=env,
+                                  cwd=BENCH_DIR.parent, check=True)
+            first, second = done.stdout.split()
+            out.append((float(first), float(second)))
+    return out
+
+
+def write(results: dict, rounds: int, path: Path, compiled: list | None = None) -> None:
     mech = linkage.load("four_bar")
     source = kernel_source(mech, 2)
     calls = sum("np." in line for line in source.splitlines())
@@ -162,6 +228,23 @@ def write(results: dict, rounds: int, path: Path) -> None:
         lines.append(f"| {n} | {t['general'] * 1e3:.3f} | {t['kernel'] * 1e3:.3f} | {t['kernel + points'] * 1e3:.3f} | "
                      f"{t['hand-fused'] * 1e3:.3f} | {r['general / kernel']:.2f} | {r['kernel / hand-fused']:.2f} | "
                      f"{r['(kernel + points) / hand-fused']:.2f} | {n / t['kernel'] / 1e6:.2f} |")
+    if any("numba kernel" in t for t, _ in results.values()):
+        lines += [
+            "",
+            "With numba (`pip install \".[fast]\"`): the same kernel as one numba loop "
+            "(linkage/kinematics/kernel_numba.py), called through the same `Kernel` (result dicts included).",
+            "",
+            "| N | numba kernel ms | numpy kernel / numba | numba / hand-fused | numba M positions/s |",
+            "|---:|---:|---:|---:|---:|",
+        ]
+        for n, (t, r) in results.items():
+            lines.append(f"| {n} | {t['numba kernel'] * 1e3:.4f} | {r['kernel / numba']:.2f} | "
+                         f"{r['numba / hand-fused']:.2f} | {n / t['numba kernel'] / 1e6:.2f} |")
+    if compiled:
+        lines += ["", "numba compile, fresh processes sharing one empty kernel cache (imports s, first kernel call s): "
+                  + "; ".join(f"{a:.2f}, {b:.3f}" for a, b in compiled)
+                  + " -- the first compiles, the next load numba's cache (their first call is mostly numba's "
+                  "own start-up)."]
     path.write_text("\n".join(lines) + "\n")
 
 
@@ -169,11 +252,18 @@ def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--rounds", type=int, default=9)
     parser.add_argument("--out", type=Path, default=BENCH_DIR / "results_kernel.md")
+    parser.add_argument("--compile-times", action="store_true", help="only time numba's compile and cache load")
     args = parser.parse_args(argv)
+    compiled = compile_times()
+    if compiled:
+        print("numba (imports s, first call s), first process compiles, next ones load: "
+              + "; ".join(f"{a:.2f}, {b:.3f}" for a, b in compiled), flush=True)
+    if args.compile_times:
+        return
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", BranchWarning)
         results = measure(args.rounds)
-    write(results, args.rounds, args.out)
+    write(results, args.rounds, args.out, compiled)
     print(f"written {args.out}")
 
 

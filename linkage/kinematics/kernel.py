@@ -50,6 +50,7 @@ from ..model.mechanism import Mechanism
 from ..structure import Structure, structure_of
 from .assembly import assembly_plans
 from .inputs import input_angles
+from .kernel_numba import numba_kernel
 
 __all__ = ["kernel_for", "run_kernel", "kernel_source", "KERNEL_BLOCK"]
 
@@ -627,8 +628,9 @@ class Kernel:
         if got is None:
             trace = _Trace(self.mech, self.structure, self.order, branches)
             where = [self.rows[k] for k, _ in trace.outputs]
-            got = self.functions[branches] = (_compiled(_source(trace)), [r for _, r in where],
-                                              [f for f, _ in where])
+            at, is_float = [r for _, r in where], [f for f, _ in where]
+            fn = numba_kernel(trace, at, is_float, _compiled(_source(trace)))   # numba's where installed
+            got = self.functions[branches] = (fn, at, is_float)
         return got
 
     def branches(self, phi: np.ndarray) -> tuple[int, ...] | None:
@@ -670,14 +672,16 @@ class Kernel:
         if len(structure.inputs) > 1:
             for q in list(input_angles(mech, structure, phi).values())[1:]:
                 inputs += [np.broadcast_to(np.asarray(v, dtype=float), phi.shape) for v in q]
-        float_rows, int_rows = list(floats), list(ints)
-        out = [float_rows[r] if f else int_rows[r] for r, f in zip(at, is_float)]
-        if N <= KERNEL_BLOCK:
-            fn(inputs, out)
-        else:
-            for start in range(0, N, KERNEL_BLOCK):
-                block = slice(start, min(start + KERNEL_BLOCK, N))
-                fn([v[block] for v in inputs], [v[block] for v in out])
+        whole = getattr(fn, "whole", None)      # the numba kernel (kernel_numba.py): one loop into the rows
+        if whole is None or not whole(inputs, floats, ints):
+            float_rows, int_rows = list(floats), list(ints)
+            out = [float_rows[r] if f else int_rows[r] for r, f in zip(at, is_float)]
+            if N <= KERNEL_BLOCK:
+                fn(inputs, out)
+            else:
+                for start in range(0, N, KERNEL_BLOCK):
+                    block = slice(start, min(start + KERNEL_BLOCK, N))
+                    fn([v[block] for v in inputs], [v[block] for v in out])
         result: dict[str, Any] = {}
         step = 3 * len(self.links)
         for j, name in enumerate(("poses", "first", "second")):
