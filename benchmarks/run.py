@@ -34,6 +34,9 @@ import os
 
 for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS"):
     os.environ[_var] = "1"
+# ours at its best: with the fast extra (numba) installed, a kernel is compiled at its first call
+# (in the warm-up) instead of after its numpy version has run a few seconds
+os.environ.setdefault("LINKAGE_NUMBA", "1")
 
 import argparse
 import cProfile

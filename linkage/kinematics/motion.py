@@ -27,7 +27,6 @@ from assur.base import (
     NOT_CONVERGED,
     OK,
     SINGULAR,
-    global_point,
     point_analogs,
 )
 from assur.rows import frame, xy
@@ -124,21 +123,25 @@ class Motion:
     # -- points, links, slides -----------------------------------------------------------------
     def point(self, name: str) -> np.ndarray:
         """Global position ``(N, 2)`` of a named point, m."""
-        link, local = self._point(name)
-        return self.poses[link][:, :2] + self.arm(link, local)
+        link, local, arm = self._point(name)
+        return self.poses[link][:, :2] + arm
 
     def point_analogs(self, name: str) -> tuple[np.ndarray, np.ndarray | None]:
         """First and second analogs ``(N, 2)`` of a named point, m/rad and m/rad^2."""
-        link, local = self._point(name)
+        link, local, arm = self._point(name)
         self._need(1)
-        return point_analogs(self.poses[link], self.first[link], self.second and self.second[link], local,
-                             self.arm(link, local))
+        return point_analogs(self.poses[link], self.first[link], self.second and self.second[link], local, arm)
 
     def _point(self, name: str):
-        link = self.mechanism.point_link(name)
-        if link not in self.poses:
-            raise InputError(f"point '{name}' (link '{link}') was not among the requested outputs")
-        return link, self.mechanism.links[link].points[name]
+        """``(link, local point, arm)`` of a named point, the arm computed once per motion."""
+        key = ("point", name)
+        if key not in self._turns:
+            link = self.mechanism.point_link(name)
+            if link not in self.poses:
+                raise InputError(f"point '{name}' (link '{link}') was not among the requested outputs")
+            local = self.mechanism.links[link].points[name]
+            self._turns[key] = (link, local, self.arm(link, local))
+        return self._turns[key]
 
     def _need(self, order: int) -> None:
         have = 0 if self.first is None else 1 if self.second is None else 2
@@ -149,12 +152,12 @@ class Motion:
         """Value and first / second analogs of ``"P.x"``, ``"P.y"``, ``"L.theta"`` or ``"K.s"``."""
         kind, obj, axis = parse_quantity(self.mechanism, name)
         if kind == "point":
-            link, local = self._point(obj)
-            value = global_point(self.poses[link], local)[:, axis]
+            link, local, arm = self._point(obj)
+            value = (self.poses[link][:, :2] + arm)[:, axis]
             if self.first is None:
                 return value, None, None
             d1, d2 = point_analogs(self.poses[link], self.first[link],
-                                   self.second and self.second[link], local)
+                                   self.second and self.second[link], local, arm)
             return value, d1[:, axis], None if d2 is None else d2[:, axis]
         if kind == "link":
             first, second = (None if d is None else d[obj][:, 2] for d in (self.first, self.second))

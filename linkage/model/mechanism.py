@@ -432,11 +432,16 @@ class Mechanism:
 
     def point_links(self, point: str) -> list[str]:
         """All links declaring ``point``, frame first, then sorted by name."""
-        owners = sorted(n for n, lk in self.links.items() if point in lk.points)
-        if self.frame in owners:
-            owners.remove(self.frame)
-            owners.insert(0, self.frame)
-        return owners
+        return list(self._point_owners.get(point, ()))
+
+    @cached_property
+    def _point_owners(self) -> dict[str, tuple[str, ...]]:
+        """Point -> the links declaring it, frame first, then sorted by name (found once)."""
+        owners: dict[str, list[str]] = {}
+        for name in sorted(self.links):
+            for point in self.links[name].points:
+                owners.setdefault(point, []).append(name)
+        return {p: tuple(sorted(names, key=lambda n: (n != self.frame, n))) for p, names in owners.items()}
 
     @cached_property
     def point_names(self) -> list[str]:
