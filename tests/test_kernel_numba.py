@@ -173,7 +173,9 @@ def test_scalar_semantics_are_numpy_s():
     flag = SimpleNamespace(op="where", args=(above, 1, 0), dtype="i", uid=len(nodes))
     nodes.append(flag)
     outputs.append(("flag", flag))
-    trace = SimpleNamespace(graph=SimpleNamespace(nodes=nodes), outputs=outputs)
+    trace = SimpleNamespace(graph=SimpleNamespace(nodes=nodes), outputs=outputs,
+                            live=lambda: ({node.uid: [j] for j, (_, node) in enumerate(outputs)},
+                                          {n.uid for n in nodes}))     # every node is needed here
     rows = list(range(len(cases))) + [0]
     source = scalar_source(trace, rows, [True] * len(cases) + [False])
     fn = kernel_numba._load(source)

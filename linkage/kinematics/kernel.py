@@ -305,6 +305,22 @@ def supported(mech: Mechanism, structure: Structure | None = None) -> bool:
 class _Trace:
     """The graph of a mechanism's kinematics and the outputs to write (name -> node or constant)."""
 
+    def live(self) -> tuple[dict[int, list[int]], set[int]]:
+        """The nodes the outputs are (node id -> the outputs' indices) and every node they need:
+        what a kernel computes, whichever language it is written in."""
+        wanted: dict[int, list[int]] = {}
+        for j, (_, value) in enumerate(self.outputs):
+            if isinstance(value, _Sym):
+                wanted.setdefault(value.uid, []).append(j)
+        needed: set[int] = set()
+        stack = [self.graph.nodes[uid] for uid in wanted]
+        while stack:
+            node = stack.pop()
+            if node.uid not in needed:
+                needed.add(node.uid)
+                stack += [a for a in node.args if isinstance(a, _Sym)]
+        return wanted, needed
+
     def __init__(self, mech: Mechanism, structure: Structure, order: int, branches: tuple[int, ...]):
         self.graph = g = _Graph()
         self.outputs: list[tuple[str, Any]] = []
@@ -479,17 +495,7 @@ def _source(trace: _Trace, name: str = "kernel") -> str:
     """The kernel's source: ``def kernel(I, O)`` computing every output of ``trace`` from the input
     arrays ``I`` (the first input's coordinates, then ``q, q', q''`` of each further input) into
     the ``(n,)`` arrays ``O`` (in the order of ``trace.outputs``)."""
-    wanted: dict[int, list[int]] = {}
-    for j, (_, value) in enumerate(trace.outputs):
-        if isinstance(value, _Sym):
-            wanted.setdefault(value.uid, []).append(j)
-    needed: set[int] = set()
-    stack = [trace.graph.nodes[uid] for uid in wanted]
-    while stack:
-        node = stack.pop()
-        if node.uid not in needed:
-            needed.add(node.uid)
-            stack += [a for a in node.args if isinstance(a, _Sym)]
+    wanted, needed = trace.live()
     nodes = [n for n in trace.graph.nodes if n.uid in needed]
     last: dict[int, int] = {}
     for p, node in enumerate(nodes):

@@ -126,17 +126,7 @@ def scalar_source(trace, rows: Sequence[int], is_float: Sequence[bool], name: st
     (int rows) as ``is_float[j]`` says.
     """
     outputs = trace.outputs
-    wanted: dict[int, list[int]] = {}
-    for j, (_, value) in enumerate(outputs):
-        if _is_node(value):
-            wanted.setdefault(value.uid, []).append(j)
-    needed: set[int] = set()
-    stack = [trace.graph.nodes[uid] for uid in wanted]
-    while stack:
-        node = stack.pop()
-        if node.uid not in needed:
-            needed.add(node.uid)
-            stack += [a for a in node.args if _is_node(a)]
+    wanted, needed = trace.live()
 
     def target(j: int) -> str:
         return f"{'F' if is_float[j] else 'J'}[{rows[j]}, i]"
