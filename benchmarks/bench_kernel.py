@@ -52,6 +52,7 @@ sys.path.insert(0, str(BENCH_DIR.parent))
 sys.path.insert(0, str(BENCH_DIR))
 
 import handfused  # noqa: E402
+from machine import cpu_model  # noqa: E402
 
 import linkage  # noqa: E402
 from assur.base import point_analogs  # noqa: E402
@@ -63,16 +64,6 @@ from linkage.structure import structure_of  # noqa: E402
 
 SIZES = (12, 360, 10_000, 100_000)
 POINTS = ("A", "B", "E")
-
-
-def cpu_model() -> str:
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    return platform.processor() or "unknown"
 
 
 def numba_kernel(mech):

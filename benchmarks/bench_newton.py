@@ -48,26 +48,18 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "benchmarks"))
 
 import assur.fused  # noqa: E402
 import linkage  # noqa: E402
 import linkage.kinematics.assembly as assembly  # noqa: E402
 from assur.generic import newton  # noqa: E402
 from linkage.kinematics import tracing  # noqa: E402
+from machine import cpu_model  # noqa: E402
 
 SCHEMES = ("six_bar_class3", "cylinder_boom")
 SIZES = (1, 12, 360)
 PATHS = ("pairwise", "fused")
-
-
-def cpu_model() -> str:
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    return platform.processor() or "unknown"
 
 
 def use(path: str) -> None:

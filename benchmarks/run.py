@@ -69,6 +69,7 @@ sys.path.insert(0, str(BENCH_DIR))
 
 import handfused
 import peers
+from machine import cpu_model
 
 import linkage
 from linkage.kinetostatics.reactions import solve_reactions
@@ -707,14 +708,7 @@ def summary(contenders: dict[str, Contender], sizes: tuple[int, ...], main_n: in
 
 def machine() -> dict:
     """CPU model (/proc/cpuinfo "model name"), cores, and the versions of Python, numpy, numba."""
-    model = "unknown"
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                model = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
+    model = cpu_model()
     try:
         numba = importlib.metadata.version("numba")
     except importlib.metadata.PackageNotFoundError:
