@@ -39,12 +39,8 @@ import numpy as np
 
 from assur.base import (ANALOG_TOL, CANNOT_ASSEMBLE, CHANGE_FACTOR, CLOSURE_TOL, OK, SINGULAR, DrivenPrismaticJoint,
                         rotate)
-from assur.prp import PRP
+from assur.dyad import Dyad
 from assur.rows import rows_of, xy
-from assur.rpp import RPP
-from assur.rpr import RPR
-from assur.rrp import RRP
-from assur.rrr import RRR
 
 from ..model.mechanism import Mechanism
 from ..structure import Structure, structure_of
@@ -54,8 +50,6 @@ from .kernel_numba import numba_kernel
 
 __all__ = ["kernel_for", "run_kernel", "kernel_source", "KERNEL_BLOCK"]
 
-#: the dyad kinds the kernel writes out (exact classes: a subclass may change the solve)
-CLOSED_FORMS = (RRR, RRP, RPR, PRP, RPP)
 #: positions computed at a time (the temporaries of a block stay in the processor's cache)
 KERNEL_BLOCK = 8192
 EPS = float(np.finfo(float).eps)
@@ -297,7 +291,9 @@ def supported(mech: Mechanism, structure: Structure | None = None) -> bool:
     if any(isinstance(j, DrivenPrismaticJoint) for j in structure.input_joints.values()):
         return False
     for g in structure.groups:
-        if type(g) not in CLOSED_FORMS or np.ndim(g.size) or any(type(j).rows != 2 for j in g.joints):
+        # a dyad solved by the shared closed-form path (its kind only places it): what the trace records
+        if not (isinstance(g, Dyad) and type(g).solve is Dyad.solve) or np.ndim(g.size) \
+                or any(type(j).rows != 2 for j in g.joints):
             return False
     return True
 
