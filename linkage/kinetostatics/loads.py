@@ -306,7 +306,8 @@ class Loads:
 class LoadTerm:
     """One load evaluated at N positions: ``force`` (N, 2) at ``local`` point of ``link`` and a
     ``moment`` (N,) on the link. ``kind`` is "gravity", "external" (resisting or neutral),
-    "driving" (a diagram declared with ``opposes = false``) or "inertia"."""
+    "driving" (a diagram declared with ``opposes = false``), "inertia" or "friction" (a pair's
+    Coulomb friction, :mod:`.friction`; ``label`` the pair)."""
 
     link: str
     local: tuple[float, float]

@@ -61,9 +61,10 @@ class Reactions:
     sense : float
         The sense of motion of a static analysis (no ``motion.omega``): +1 the input's coordinate
         increasing, -1 decreasing; the friction opposes it and the powers are per unit of speed.
-    locked, locked_pair : ndarray (N,) of bool and of str, or None
-        With friction: the positions where no finite balancing load moves the mechanism
-        (self-locking; every value NaN there) and the pair whose friction locks it.
+    locked_pair : ndarray (N,) of str, or None
+        With friction: at the positions where no finite balancing load moves the mechanism
+        (self-locking; every value NaN there, :attr:`locked`) the pair whose friction locks it,
+        "" elsewhere.
     balancing_moments : dict of input link -> ndarray (N,)
         The balancing moment of every input link, N m (CCW positive), or force, N, for a slide
         input: with several inputs (:class:`~linkage.model.input_laws.InputLaw`), each motor's share; the
@@ -78,9 +79,13 @@ class Reactions:
     notes: tuple[str, ...] = ()
     balancing_moments: dict[str, np.ndarray] = field(default_factory=dict)
     friction: Friction | None = None
-    locked: np.ndarray | None = None
     locked_pair: np.ndarray | None = None
     sense: float = 1.0
+
+    @property
+    def locked(self) -> np.ndarray | None:
+        """With friction: where the mechanism self-locks (bool (N,)); None without friction."""
+        return None if self.locked_pair is None else self.locked_pair != ""
 
     def force(self, pair: str) -> np.ndarray:
         """``R[a, b]`` ``(N, 2)`` for the pair declared with ``links = [a, b]``, N."""
@@ -167,10 +172,9 @@ class Reactions:
         out["driving"] = out["driving"] + self.balancing_moment * speed
         for link in self.motion.structure.inputs[1:]:
             out["driving"] = out["driving"] + self.balancing_moments[link] * rates[link][1] * speed
-        kinds = {"driving": "driving", "external": "useful", "gravity": "gravity", "inertia": "inertia",
-                 "friction": "friction"}
-        for t in self.terms:
-            out[kinds.get(t.kind, "useful")] = out[kinds.get(t.kind, "useful")] + self.term_power(t)
+        for t in self.terms:              # an external load is the useful resistance
+            kind = "useful" if t.kind == "external" else t.kind
+            out[kind] = out[kind] + self.term_power(t)
         return out
 
     def efficiency(self) -> np.ndarray:
@@ -343,8 +347,7 @@ def reactions_under(motion: Motion, terms: list[LoadTerm], pairs: Iterable[str] 
         notes = notes + ("balancing moment not computed: only the reactions in pairs "
                          f"{sorted(pairs)} were asked for",)
         return Reactions(motion, multipliers, np.full(n, np.nan), terms, notes, friction=friction,
-                         locked=(locked_pair != "") if friction else None, locked_pair=locked_pair if friction else None,
-                         sense=static)
+                         locked_pair=locked_pair if friction else None, sense=static)
     balancing = {}
     for link in structure.inputs:
         # each input link's equilibrium: the drive takes the load's part along the link's motion
@@ -381,8 +384,7 @@ def reactions_under(motion: Motion, terms: list[LoadTerm], pairs: Iterable[str] 
         terms = [replace(t, force=np.where(locked[:, None], np.nan, t.force), moment=np.where(locked, np.nan, t.moment))
                  if t.kind == "friction" else t for t in terms]
     return Reactions(motion, multipliers, balancing[structure.inputs[0]], terms, notes, balancing, friction=friction,
-                     locked=locked if friction else None, locked_pair=locked_pair if friction else None,
-                     sense=static)
+                     locked_pair=locked_pair if friction else None, sense=static)
 
 
 def _sense(motion: Motion, sense: float | None) -> np.ndarray:
