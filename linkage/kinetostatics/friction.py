@@ -33,7 +33,7 @@ from typing import Any, Callable, Mapping
 
 import numpy as np
 
-from assur.base import PrismaticJoint, RevoluteJoint
+from assur.base import PrismaticJoint, RevoluteJoint, cross
 
 from ..model.mechanism import Mechanism
 from ..model.numbers import check_number, unknown_keys
@@ -201,7 +201,7 @@ def friction_terms(motion, friction: Friction, multipliers: Mapping[str, np.ndar
     """
     terms: list[LoadTerm] = []
     size = motion.mechanism.size
-    zero = np.zeros(len(motion.phi))
+    no_force = np.zeros((len(motion.phi), 2))
     for name, lam in multipliers.items():
         spec = friction.pairs.get(name)
         joint = motion.joints.get(name)
@@ -212,8 +212,8 @@ def friction_terms(motion, friction: Friction, multipliers: Mapping[str, np.ndar
             rel = motion.first[a][:, 2] - motion.first[b][:, 2]
             rel2 = motion.second[a][:, 2] - motion.second[b][:, 2]
             moment = -spec.f * spec.radius * np.hypot(lam[:, 0], lam[:, 1]) * _sense(rel, rel2, 1.0, sense)
-            terms += [LoadTerm(a, (0.0, 0.0), np.zeros((len(zero), 2)), moment, "friction", name),
-                      LoadTerm(b, (0.0, 0.0), np.zeros((len(zero), 2)), -moment, "friction", name)]
+            terms += [LoadTerm(a, (0.0, 0.0), no_force, moment, "friction", name),
+                      LoadTerm(b, (0.0, 0.0), no_force, -moment, "friction", name)]
         elif isinstance(joint, PrismaticJoint):
             u, _, _, pb, _ = joint.frame(motion.poses)
             _, s1, s2 = joint.slide(motion.poses, motion.first, motion.second)
@@ -225,9 +225,7 @@ def friction_terms(motion, friction: Friction, multipliers: Mapping[str, np.ndar
             force = -(spec.f * pressing * _sense(s1, s2, size, sense))[:, None] * u     # on the slider b
             at = motion.poses[b][:, :2] + pb                                           # the slider's point
             for link, f in ((b, force), (a, -force)):
-                arm = at - motion.poses[link][:, :2]
-                terms.append(LoadTerm(link, (0.0, 0.0), f, arm[:, 0] * f[:, 1] - arm[:, 1] * f[:, 0], "friction",
-                                      name))
+                terms.append(LoadTerm(link, (0.0, 0.0), f, cross(at - motion.poses[link][:, :2], f), "friction", name))
     return terms
 
 
@@ -247,7 +245,6 @@ class GroupFriction:
     terms: list[LoadTerm]
     locked: np.ndarray
     worst: str
-    iterations: int
 
 
 def group_with_friction(motion, solve: Callable[[dict], tuple[dict, dict]], applied: dict[str, np.ndarray],
@@ -278,10 +275,11 @@ def group_with_friction(motion, solve: Callable[[dict], tuple[dict, dict]], appl
         return np.concatenate([multipliers[k][:, :2] for k in names], axis=1)
 
     def phi_of(x):
-        pairs = {k: x[:, 2 * j:2 * j + 2] for j, k in enumerate(names)}
-        extra = generalized_loads(motion, friction_terms(motion, friction, pairs, sense))
+        """Φ(x), the solve's multipliers and transmitted loads, and the friction loads of x."""
+        terms = friction_terms(motion, friction, {k: x[:, 2 * j:2 * j + 2] for j, k in enumerate(names)}, sense)
+        extra = generalized_loads(motion, terms)
         new, sent = solve({k: (v + extra[k] if k in links else v) for k, v in applied.items()})
-        return unknowns(new), new, sent
+        return unknowns(new), new, sent, terms
 
     def residual(x, image):
         return np.max(np.abs(x - image), axis=1)
@@ -289,7 +287,7 @@ def group_with_friction(motion, solve: Callable[[dict], tuple[dict, dict]], appl
     x = unknowns(lam)
     converged = ~active
     for _ in range(FIXED_POINT_STEPS):
-        image, lam, transmitted = phi_of(x)
+        image, lam, transmitted, _ = phi_of(x)
         size = np.maximum(_size(lam, n), floor)
         converged |= residual(x, image) <= FRICTION_TOL * size
         x = image
@@ -298,7 +296,7 @@ def group_with_friction(motion, solve: Callable[[dict], tuple[dict, dict]], appl
     steps = 0
     while not converged.all() and steps < FRICTION_ITERATIONS:
         steps += 1
-        image, lam, transmitted = phi_of(x)
+        image, lam, transmitted, _ = phi_of(x)
         g = x - image
         size = np.maximum(_size(lam, n), floor)
         converged |= np.max(np.abs(g), axis=1) <= FRICTION_TOL * size
@@ -320,15 +318,14 @@ def group_with_friction(motion, solve: Callable[[dict], tuple[dict, dict]], appl
         except np.linalg.LinAlgError:
             break
         x = np.where(todo[:, None], x + step, image)
-    image, lam, transmitted = phi_of(x)
+    image, lam, transmitted, terms = phi_of(x)
     size = np.maximum(_size(lam, n), floor)
     locked = valid & ~(active & (residual(x, image) <= 1e3 * FRICTION_TOL * size) & (size <= LOCKED_GROWTH * floor))
-    terms = friction_terms(motion, friction, {k: x[:, 2 * j:2 * j + 2] for j, k in enumerate(names)}, sense)
     worst = ""
     if locked.any():
         growth = {k: float(np.nanmax(np.abs(lam[k][locked]) / floor[locked, None])) for k in names}
         worst = max(growth, key=growth.get) if growth else ""
-    return GroupFriction(lam, transmitted, terms, locked, worst, steps)
+    return GroupFriction(lam, transmitted, terms, locked, worst)
 
 
 def _size(lam: Mapping[str, np.ndarray], n: int) -> np.ndarray:
