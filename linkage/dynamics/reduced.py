@@ -23,7 +23,7 @@ With ``s = sign(omega_m)`` and ``psi = s phi`` (the angle in the direction of ro
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Callable
 
 import numpy as np
@@ -164,13 +164,10 @@ def reduced_characteristics(
             resisting += power
     lost = None
     if friction:
-        if speed is None:
-            at_speed = motion
-        elif callable(speed):
-            omega, eps = speed(motion.phi)
-            at_speed = analyze(mech, motion.phi, order=2, omega=omega, eps=eps)
-        else:
-            at_speed = analyze(mech, motion.phi, order=2, omega=float(speed), eps=0.0)
+        # the same positions and analogs at the speed asked: only the real velocities change
+        omega, eps = speed(motion.phi) if callable(speed) else (float(rotation if speed is None else speed), 0.0)
+        at_speed = replace(motion, omega=np.broadcast_to(np.asarray(omega, float), n).copy(),
+                           eps=np.broadcast_to(np.asarray(eps, float), n).copy())
         reactions = solve_reactions(at_speed, loads, ends=ends, friction=friction, sense=rotation)
         lost = rotation * reactions.friction_power() / reactions.speed()
         resisting = resisting + lost
