@@ -186,7 +186,7 @@ def _solve_regular(a: np.ndarray, b: np.ndarray):
         try:
             with np.errstate(invalid="ignore", over="ignore", divide="ignore", under="ignore"):
                 x = _SOLVE(a, b) if _SOLVE is not None else np.linalg.solve(a, b[..., None])[..., 0]
-        except np.linalg.LinAlgError:
+        except (np.linalg.LinAlgError, TypeError, ValueError):   # a numpy whose private solve differs too
             x = None
         if x is not None and np.isfinite(x).all():
             return x, True
