@@ -28,7 +28,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-pytest.importorskip("numba")
+pytest.importorskip("numba", reason="the fast extra (numba) is not installed: pip install \".[fast]\"")
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
