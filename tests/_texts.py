@@ -39,15 +39,16 @@ links = ["3", "0"]
 
 
 def slider_crank_toml(crank, rod, assembly='from = "A"\ntowards_deg = 0', *, name="slider_crank",
-                      header="", tail="") -> str:
-    """Central slider-crank: crank OA about O = (0, 0), rod AB, slider B on the x axis."""
+                      header="", tail="", offset=0.0) -> str:
+    """Slider-crank: crank OA about O = (0, 0), rod AB, slider B on the guide ``slide`` along x at
+    y = ``offset`` (central by default)."""
     return f"""
 name = "{name}"
 input = "1"
 {header}
 [links.0]
 points = {{ O = [0.0, 0.0] }}
-guides.slide = {{ through = [0.0, 0.0], angle_deg = 0 }}
+guides.slide = {{ through = [0.0, {offset!r}], angle_deg = 0 }}
 [links.1]
 line = ["O", "A"]
 length = {crank!r}

@@ -43,6 +43,8 @@ import linkage
 from linkage.kinetostatics.efficiency import cycle_works
 from linkage.kinetostatics.reactions import solve_reactions
 
+from _texts import slider_crank_toml
+
 G = np.array([0.0, -9.81])
 OMEGA, EPS = 10.0, 3.0              # rad/s, rad/s^2 (a crank)
 SLIDE_SPEED, SLIDE_ACC = 0.5, 0.2   # m/s, m/s^2 (a slide input)
@@ -374,38 +376,6 @@ def test_cycle_useful_work_closed_form():
 # ----------------------------------------------------------------------------------------------
 
 
-def slider_crank_text(r, l, e, name):
-    return f"""
-name = "{name}"
-input = "1"
-[links.0]
-points = {{ O = [0.0, 0.0] }}
-guides.press = {{ through = [0.0, {e!r}], angle_deg = 0 }}
-[links.1]
-line = ["O", "A"]
-length = {r!r}
-[links.2]
-line = ["A", "B"]
-length = {l!r}
-[links.3]
-points.B = [0.0, 0.0]
-[pairs.O]
-links = ["0", "1"]
-[pairs.A]
-links = ["1", "2"]
-[pairs.B]
-links = ["2", "3"]
-[pairs.press]
-kind = "P"
-links = ["0", "3"]
-guide = "press"
-at = "B"
-[assembly.B]
-from = "O"
-towards_deg = 0
-"""
-
-
 def closed_form(phi, r, l, e, f, q):
     """Slider-crank with friction in its guide only, a load q (N) along x on the slider, static,
     the crank turning CCW: (beta, dx_B/dphi, M_b). Where q resists (q v_B < 0),
@@ -422,7 +392,7 @@ def closed_form(phi, r, l, e, f, q):
 
 
 def slider_crank_with(r, l, e, f, q, name="offset_press"):
-    mech = linkage.loads(slider_crank_text(r, l, e, name))
+    mech = linkage.loads(slider_crank_toml(r, l, 'from = "O"\ntowards_deg = 0', name=name, offset=e))
     return mech.with_extra(loads={"gravity": [0.0, -9.81], "forces": [{"point": "B", "link": "3", "force": [q, 0.0]}]},
                            friction={"prismatic": {"f": f}})
 
@@ -444,11 +414,11 @@ def test_self_locking_offset_slider_crank():
     assert locked.sum() >= 5                                         # the scheme does reach the cone
     assert np.all(np.isnan(moment[locked]))                          # (the closed form: no solution)
     assert np.all(reactions.locked[locked])
-    assert all(p == "press" for p in reactions.locked_pair[locked])
+    assert all(p == "slide" for p in reactions.locked_pair[locked])
     assert np.all(np.isnan(reactions.balancing_moment[locked]))
     assert all(np.all(np.isnan(v[locked])) for v in reactions.multipliers.values())
     note = next(n for n in reactions.notes if "self-locking" in n)
-    assert "press" in note and "f = 0.15" in note
+    assert "pair slide" in note and "f = 0.15" in note
 
     # outside the cone, up to close to its edge, on both strokes (the load resisting, and driving),
     # away from the dead centres
