@@ -270,7 +270,7 @@ class _Work:
         reactions = self.forces.reactions
         self._picture("friction", f"Friction in the pairs: the power lost in each pair and the efficiency η "
                                   f"({self._speed_note()})",
-                      lambda: plot_friction(reactions, reactions.motion.direction))
+                      lambda: plot_friction(reactions, reactions.motion.direction, cycle=self.forces.cycle))
 
     def _speed_note(self) -> str:
         """At what speed the forces were found: a static case says so."""

@@ -24,7 +24,7 @@ from ..dynamics.pipeline import DynamicsReport, run_dynamics
 from ..errors import InputError
 from ..kinematics.extremes import table_angles
 from ..kinematics.motion import Motion, analyze, position_column, table_positions_deg
-from ..kinetostatics.efficiency import cycle_works
+from ..kinetostatics.efficiency import CycleWorks, cycle_works
 from ..kinetostatics.reactions import solve_reactions, virtual_power_residual
 from ..model.mechanism import Mechanism
 from ..model.scheme import section_of
@@ -99,7 +99,8 @@ class TableResults:
     """A table of ``linkage analyze`` or ``linkage forces``: ``columns``, the JSON metadata
     ``meta`` (scheme, positions, start, phi0_deg, direction, failed ...), the ``motion`` analysed,
     the ``notes`` and ``warnings`` to say to the user (one line each) and, for ``linkage forces``,
-    the :class:`~linkage.kinetostatics.reactions.Reactions` the columns come from."""
+    the :class:`~linkage.kinetostatics.reactions.Reactions` the columns come from and, with
+    friction, the :class:`~linkage.kinetostatics.efficiency.CycleWorks` of ``meta["cycle"]``."""
 
     columns: dict[str, np.ndarray]
     meta: dict[str, Any]
@@ -107,6 +108,7 @@ class TableResults:
     notes: list[str] = field(default_factory=list)
     warnings: list[str] = field(default_factory=list)
     reactions: Any = None
+    cycle: Any = None
 
     def json(self) -> str:
         """The JSON document of the command (every column)."""
@@ -325,9 +327,9 @@ def forces_results(mech: Mechanism, positions: int | None = None, start: str | f
             notes.append("static analysis: the friction opposes the input's "
                          f"{'increasing' if travel > 0 else 'decreasing'} coordinate; power_lost and K.power_lost "
                          "are per unit of its speed (W per rad/s, i.e. N m; W per m/s for a slide input)")
-        meta["cycle"] = cycle
+        meta["cycle"] = _cycle_meta(cycle)
     return TableResults(_friction_first(reactions.columns(full=True)), meta, motion, notes,
-                        lines + _caught(caught, failed), reactions)
+                        lines + _caught(caught, failed), reactions, cycle)
 
 
 def _friction_first(columns: dict) -> dict:
@@ -341,15 +343,20 @@ def _friction_first(columns: dict) -> dict:
     return {k: columns[k] for k in order}
 
 
-def friction_cycle(mech: Mechanism, omega: float | None, notes: list[str]) -> dict | None:
-    """The works of one turn with friction at constant speed (``cycle_works``) as a table's meta,
-    None (with a note) where the input is not a crank turning fully."""
+def friction_cycle(mech: Mechanism, omega: float | None, notes: list[str]) -> CycleWorks | None:
+    """The works of one turn with friction at constant speed (``cycle_works``), None (with a
+    note) where the input is not a crank turning fully."""
     try:
-        works = cycle_works(mech, omega, friction=True)
+        return cycle_works(mech, omega, friction=True)
     except InputError as exc:
         notes.append(f"no cycle efficiency: {exc}")
         return None
-    unit = "J"
+
+
+def _cycle_meta(works: CycleWorks | None) -> dict | None:
+    """The table's ``meta["cycle"]``: the works of one turn, J."""
+    if works is None:
+        return None
     return {"driving_work": works.driving + 0.0, "useful_work": works.useful + 0.0,
-            "friction_work": works.friction + 0.0, "efficiency": works.efficiency + 0.0, "samples": works.samples, "locked_samples": works.locked,
-            "omega": works.omega, "unit": unit}
+            "friction_work": works.friction + 0.0, "efficiency": works.efficiency + 0.0, "samples": works.samples,
+            "locked_samples": works.locked, "omega": works.omega, "unit": "J"}
