@@ -337,3 +337,7 @@ class _Demo:
         flag = N(op="where", args=(big, 2, 0), dtype="i", uid=3)
         self.graph = N(nodes=[x, square, big, flag])
         self.outputs = [("square", square), ("flag", flag)]
+
+    def live(self):
+        """The outputs' nodes and every node: all are needed here (see ``_Trace.live``)."""
+        return {1: [0], 3: [1]}, {0, 1, 2, 3}
