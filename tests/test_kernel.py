@@ -5,7 +5,8 @@ oracle. For every shipped scheme whose groups are all closed-form dyads, for the
 of every dyad kind at and around their singular positions (tests/_edge_mechanisms.py), and for
 random chains of one to three dyads of all five kinds (tests/_chains.py) on the declared and the
 flipped branches, the kernel must give the same statuses (each group's and the mechanism's) and
-conditioning, and poses, first / second analogs and error bounds equal to 1e-13 relative to
+conditioning, and poses, first / second analogs, the named points with their analogs and error
+bounds equal to 1e-13 relative to
 the mechanism's size (to 1e-13 relative for the analogs and bounds, which grow without bound
 near a singular position), with NaN at the same positions.
 """
@@ -30,6 +31,7 @@ from linkage.kinematics.assembly import assembly_plans  # noqa: E402
 from linkage.kinematics.kernel import KERNEL_BLOCK, kernel_for, kernel_source, run_kernel  # noqa: E402
 from linkage.kinematics.motion import BranchWarning, run_blocks  # noqa: E402
 from linkage.structure import structure_of  # noqa: E402
+from assur.base import global_point, point_analogs  # noqa: E402
 
 import _chains as C  # noqa: E402
 import _edge_mechanisms as E  # noqa: E402
@@ -50,9 +52,17 @@ def general(mech, phi, order, branches=None):
     if branches is not None:
         plans = tuple(replace(p, branch=b, mode="keep") for p, b in zip(plans, branches))
     run = run_blocks(mech, structure, plans, list(range(len(structure.groups))), phi, order)
+    points = {}
+    for point in mech.point_names:
+        link = mech.point_link(point)
+        if link != mech.frame:
+            pose, local = run.poses[link], mech.links[link].points[point]
+            analogs = (None, None) if order == 0 else \
+                point_analogs(pose, run.first[link], run.second and run.second[link], local)
+            points[point] = (global_point(pose, local), *analogs)
     return {"poses": run.poses, "first": run.first, "second": run.second, "status": run.status,
             "conditioning": run.conditioning, "error_bound": run.error_bound, "signs": run.signs,
-            "solved": run.solved}
+            "solved": run.solved, "points": points}
 
 
 def assert_same(got: dict, ref: dict, size: float, what: str) -> None:
@@ -74,6 +84,14 @@ def assert_same(got: dict, ref: dict, size: float, what: str) -> None:
         for link, value in ref[name].items():
             scale = np.abs(value) + np.array([size, size, 1.0])
             _close(got[name][link], value, TOL * scale, f"{what}: {name} of link {link}")
+    assert got["points"].keys() == ref["points"].keys(), f"{what}: the points"
+    for point, values in ref["points"].items():
+        for name, value, mine in zip(("position", "first analog", "second analog"), values, got["points"][point]):
+            if value is None:
+                assert mine is None, f"{what}: {name} of point {point} beyond the order"
+                continue
+            scale = np.abs(value) + size
+            _close(mine, value, TOL * scale, f"{what}: {name} of point {point}")
 
 
 def _close(got, ref, tol, what):

@@ -346,9 +346,15 @@ class _Trace:
             error = np.maximum(error, v)
         self.outputs += [("status", status), ("error", error)]
         bad = status != OK
+        masked = {}
         for name, analogs in (("first", first), ("second", second)):
-            for k, values in (analogs or {}).items():
-                self.outputs += [(f"{name} {k} {c}", np.where(bad, np.nan, v)) for c, v in enumerate(values)]
+            masked[name] = {k: tuple(np.where(bad, np.nan, v) for v in values) for k, values in (analogs or {}).items()}
+            for k, values in masked[name].items():
+                self.outputs += [(f"{name} {k} {c}", v) for c, v in enumerate(values)]
+        poses = {k: (f[0], f[1], f[4]) for k, f in frames.items() if k != mech.frame}
+        for point, link in moving_points(mech).items():
+            self.outputs += _point(poses[link], masked["first"].get(link), masked["second"].get(link),
+                                   mech.links[link].points[point], point)
 
     def _inputs(self, mech, structure, order, params):
         """:func:`linkage.kinematics.inputs.input_state` on symbols: the frames and the analogs
@@ -379,6 +385,30 @@ class _Trace:
             if second is not None:
                 second[name] = d2
         return frames, first, second
+
+
+def moving_points(mech: Mechanism) -> dict[str, str]:
+    """Each named point that a moving link reports (:meth:`Mechanism.point_link`) -> that link."""
+    owners = {p: mech.point_link(p) for p in mech.point_names}
+    return {p: k for p, k in owners.items() if k != mech.frame}
+
+
+def _point(pose, first, second, local, name: str) -> list[tuple[str, Any]]:
+    """:meth:`linkage.kinematics.motion.Motion.point` and ``point_analogs`` on symbols (the link's
+    cosines and sines of its angle, as :func:`assur.rows.frame` takes them): the outputs
+    ``point P c``, ``point first P c``, ``point second P c``."""
+    x, y, theta = pose
+    (px, py), c, s = xy(local), np.cos(theta), np.sin(theta)
+    rx, ry = c * px - s * py, s * px + c * py
+    out = [(f"point {name} 0", x + rx), (f"point {name} 1", y + ry)]
+    if first is not None:
+        out += [(f"point first {name} 0", first[0] + (-ry) * first[2]),
+                (f"point first {name} 1", first[1] + rx * first[2])]
+    if second is not None:
+        turn2 = first[2] ** 2
+        out += [(f"point second {name} 0", second[0] + (-ry) * second[2] - rx * turn2),
+                (f"point second {name} 1", second[1] + rx * second[2] - ry * turn2)]
+    return out
 
 
 def _slider(joint, link, s, rate, accel):
@@ -604,6 +634,11 @@ class Kernel:
             for k in links:
                 for c in range(3):
                     rows[f"{kind} {k} {c}"] = (True, len(rows))
+        self.points = list(moving_points(mech))
+        for kind in ("point", "point first", "point second")[:order + 1]:
+            for point in self.points:
+                for c in range(2):
+                    rows[f"{kind} {point} {c}"] = (True, len(rows))
         n_groups = len(structure.groups)
         for i in range(n_groups):
             rows[f"conditioning {i}"] = (True, len(rows))
@@ -690,6 +725,12 @@ class Kernel:
             result[name] = None if j > self.order else \
                 {k: floats[j * step + 3 * i:j * step + 3 * i + 3].T for i, k in enumerate(self.links)}
         start = (self.order + 1) * step
+        points = {}
+        for point in self.points:
+            at = [start + 2 * (j * len(self.points) + self.points.index(point)) for j in range(self.order + 1)]
+            points[point] = tuple(floats[r:r + 2].T for r in at) + (None,) * (2 - self.order)
+        result["points"] = points
+        start += 2 * (self.order + 1) * len(self.points)
         groups = structure.groups
         result["conditioning"] = {repr(g): floats[start + 2 * i] for i, g in enumerate(groups)}
         result["signs"] = {i: floats[start + 2 * i + 1] for i in range(len(groups))}
@@ -732,7 +773,9 @@ def run_kernel(mech: Mechanism, phi, order: int = 2) -> dict | None:
         ``poses``, ``first``, ``second``: link -> ``(N, 3)`` (None above ``order``); ``status``
         ``(N,)`` int; ``conditioning``: group label -> ``(N,)``; ``error_bound`` ``(N,)``;
         ``signs``, ``solved``: group index -> the sign of its Jacobian's determinant and its own
-        status ``(N,)``; ``branches``: each group's branch. None where the kernel does not apply
+        status ``(N,)``; ``branches``: each group's branch; ``points``: each point that a moving
+        link reports -> its position and first and second analogs, each ``(N, 2)`` (None above
+        ``order``). None where the kernel does not apply
         (:func:`kernel_for`) or a group's branch changes among ``phi``: run the general path.
     """
     kernel = kernel_for(mech, order)

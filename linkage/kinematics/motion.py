@@ -123,14 +123,24 @@ class Motion:
     # -- points, links, slides -----------------------------------------------------------------
     def point(self, name: str) -> np.ndarray:
         """Global position ``(N, 2)`` of a named point, m."""
-        link, local, arm = self._point(name)
-        return self.poses[link][:, :2] + arm
+        return self._point_values(name)[0]
 
     def point_analogs(self, name: str) -> tuple[np.ndarray, np.ndarray | None]:
         """First and second analogs ``(N, 2)`` of a named point, m/rad and m/rad^2."""
-        link, local, arm = self._point(name)
         self._need(1)
-        return point_analogs(self.poses[link], self.first[link], self.second and self.second[link], local, arm)
+        return self._point_values(name)[1:]
+
+    def _point_values(self, name: str) -> tuple[np.ndarray, np.ndarray | None, np.ndarray | None]:
+        """Position and first and second analogs of a named point (None beyond the order
+        computed), computed once per motion (by the compiled kernel, where it ran)."""
+        key = ("point values", name)
+        if key not in self._turns:
+            link, local, arm = self._point(name)
+            pose = self.poses[link]
+            analogs = (None, None) if self.first is None else \
+                point_analogs(pose, self.first[link], self.second and self.second[link], local, arm)
+            self._turns[key] = (pose[:, :2] + arm, *analogs)
+        return self._turns[key]
 
     def _point(self, name: str):
         """``(link, local point, arm)`` of a named point, the arm computed once per motion."""
@@ -152,13 +162,7 @@ class Motion:
         """Value and first / second analogs of ``"P.x"``, ``"P.y"``, ``"L.theta"`` or ``"K.s"``."""
         kind, obj, axis = parse_quantity(self.mechanism, name)
         if kind == "point":
-            link, local, arm = self._point(obj)
-            value = (self.poses[link][:, :2] + arm)[:, axis]
-            if self.first is None:
-                return value, None, None
-            d1, d2 = point_analogs(self.poses[link], self.first[link],
-                                   self.second and self.second[link], local, arm)
-            return value, d1[:, axis], None if d2 is None else d2[:, axis]
+            return tuple(None if v is None else v[:, axis] for v in self._point_values(obj))
         if kind == "link":
             first, second = (None if d is None else d[obj][:, 2] for d in (self.first, self.second))
             return self.poses[obj][:, 2], first, second
@@ -382,9 +386,12 @@ def analyze(
     if omega is not None:
         omega_arr = np.broadcast_to(np.asarray(omega, dtype=float), phi.shape).copy()
         eps_arr = np.broadcast_to(np.asarray(0.0 if eps is None else eps, dtype=float), phi.shape).copy()
-    return Motion(mech, structure, phi, poses, first if order >= 1 else None,
-                  second if order >= 2 else None, status, omega_arr, eps_arr, run.conditioning,
-                  run.error_bound)
+    motion = Motion(mech, structure, phi, poses, first if order >= 1 else None,
+                    second if order >= 2 else None, status, omega_arr, eps_arr, run.conditioning,
+                    run.error_bound)
+    for point, values in (run.points or {}).items():
+        motion._turns["point values", point] = values
+    return motion
 
 
 def _kernel_run(mech: Mechanism, phi: np.ndarray, order: int) -> _Run | None:
@@ -396,7 +403,7 @@ def _kernel_run(mech: Mechanism, phi: np.ndarray, order: int) -> _Run | None:
     if got is None:
         return None
     return _Run(got["poses"], got["first"], got["second"], got["status"], got["conditioning"],
-                got["error_bound"], got["signs"], got["solved"])
+                got["error_bound"], got["signs"], got["solved"], got["points"])
 
 
 def _check_law_domains(mech: Mechanism, phi: np.ndarray) -> None:
@@ -461,6 +468,7 @@ class _Run:
     error_bound: np.ndarray
     signs: dict[int, np.ndarray]     # group index -> sign of its Jacobian determinant (N,)
     solved: dict[int, np.ndarray]    # group index -> the group's own status (N,)
+    points: dict[str, tuple] | None = None   # the kernel's: point -> position, first, second analogs (N, 2)
 
 
 def run_blocks(mech: Mechanism, structure: Structure, plans, group_ids: list[int], phi: np.ndarray,
