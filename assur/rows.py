@@ -25,7 +25,10 @@ __all__ = ["xy", "frame", "arm", "RevoluteRows", "PrismaticRows", "rows_of"]
 
 
 def xy(p):
-    """The two coordinates of local point(s) ``(2,)`` or ``(N, 2)``: floats or ``(N,)`` arrays."""
+    """The two coordinates of local point(s) ``(2,)`` or ``(N, 2)``: floats or ``(N,)`` arrays
+    (a tuple of two columns passes as it is)."""
+    if type(p) is tuple and len(p) == 2 and not isinstance(p[0], (int, float)):
+        return p
     p = np.asarray(p, dtype=float)
     return (float(p[0]), float(p[1])) if p.ndim == 1 else (p[:, 0], p[:, 1])
 

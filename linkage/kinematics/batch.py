@@ -29,7 +29,9 @@ from ..errors import AssemblyError, InputError
 from ..model.mechanism import Mechanism
 from ..structure import Structure, structure_of
 from .assembly import assembly_plans
-from .motion import JUMP_CHECK_STEP, BranchWarning, Motion, jump_steps, links_needed, run_blocks
+from . import motion
+from .kernel_variants import columns, variant_kernel_for
+from .motion import JUMP_CHECK_STEP, BranchWarning, Motion, _kernel_results, jump_steps, links_needed, run_blocks
 
 __all__ = ["OTHER_BRANCH", "VariantMotion", "analyze_variants", "geometry_of"]
 
@@ -212,7 +214,11 @@ def analyze_variants(
     size = np.repeat(_sizes(mech, local), n)
     batch = _BatchStructure(mech, base, local, n, size)
     structure = batch.whole
-    run = run_blocks(mech, structure, plans, group_ids, np.tile(phi, count), order, batch.at)
+    kernel = variant_kernel_for(mech, order) if outputs is None and motion.USE_KERNEL else None
+    got = None if kernel is None else kernel(np.tile(phi, count), None, columns(base, batch.joints, size))
+    run = None if got is None else _kernel_results(got)
+    if run is None:
+        run = run_blocks(mech, structure, plans, group_ids, np.tile(phi, count), order, batch.at)
     status = run.status.reshape(count, n)
     mode_change = np.zeros(count, bool)
     for i in group_ids:

@@ -317,13 +317,16 @@ class _Trace:
                 stack += [a for a in node.args if isinstance(a, _Sym)]
         return wanted, needed
 
-    def __init__(self, mech: Mechanism, structure: Structure, order: int, branches: tuple[int, ...]):
+    def __init__(self, mech: Mechanism, structure: Structure, order: int, branches: tuple[int, ...],
+                 geometry: Callable | None = None):
         self.graph = g = _Graph()
         self.outputs: list[tuple[str, Any]] = []
         n_inputs = len(structure.inputs)
         params = [g.node("input", (0,), "f")]
         for k in range(1, n_inputs):
             params += [g.node("input", (3 * k - 2 + i,), "f") for i in range(3)]
+        if geometry is not None:     # the geometry as further inputs (kernel_variants.py), no named points
+            structure = geometry(g, len(params))
         self.n_params = len(params)
         frames, first, second = self._inputs(mech, structure, order, params)
         errors: dict[str, Any] = {k: 0.0 for k in (mech.frame, *structure.inputs)}
@@ -352,7 +355,7 @@ class _Trace:
             for k, values in masked[name].items():
                 self.outputs += [(f"{name} {k} {c}", v) for c, v in enumerate(values)]
         poses = {k: (f[0], f[1], f[4]) for k, f in frames.items() if k != mech.frame}
-        for point, link in moving_points(mech).items():
+        for point, link in (moving_points(mech) if geometry is None else {}).items():
             self.outputs += _point(poses[link], masked["first"].get(link), masked["second"].get(link),
                                    mech.links[link].points[point], point)
 
@@ -623,9 +626,9 @@ class Kernel:
     and one ``(G + 1, N)`` of ints (the status, each group's own status); the dicts hold views.
     """
 
-    def __init__(self, mech: Mechanism, structure: Structure, order: int):
+    def __init__(self, mech: Mechanism, structure: Structure, order: int, geometry: Callable | None = None):
         self._mech = weakref.ref(mech)     # kept per mechanism in a module dict: no strong reference back
-        self.structure, self.order = structure, order
+        self.structure, self.order, self.geometry = structure, order, geometry
         self.functions: dict[tuple[int, ...], tuple[Callable, list[int], list[bool]]] = {}
         links = [mech.frame, *structure.inputs, *(k for g in structure.groups for k in g.links)]
         self.links = links
@@ -634,7 +637,7 @@ class Kernel:
             for k in links:
                 for c in range(3):
                     rows[f"{kind} {k} {c}"] = (True, len(rows))
-        self.points = list(moving_points(mech))
+        self.points = list(moving_points(mech)) if geometry is None else []
         for kind in ("point", "point first", "point second")[:order + 1]:
             for point in self.points:
                 for c in range(2):
@@ -656,14 +659,14 @@ class Kernel:
 
     def source(self, branches: tuple[int, ...]) -> str:
         """The Python source of the kernel for the groups' ``branches``."""
-        return _source(_Trace(self.mech, self.structure, self.order, branches))
+        return _source(_Trace(self.mech, self.structure, self.order, branches, self.geometry))
 
     def function(self, branches: tuple[int, ...]) -> tuple[Callable, list[int], list[bool]]:
         """The compiled kernel for ``branches``, and for each of its outputs in order its row and
         whether it is a float (else an int) row."""
         got = self.functions.get(branches)
         if got is None:
-            trace = _Trace(self.mech, self.structure, self.order, branches)
+            trace = _Trace(self.mech, self.structure, self.order, branches, self.geometry)
             where = [self.rows[k] for k, _ in trace.outputs]
             at, is_float = [r for _, r in where], [f for f, _ in where]
             fn = numba_kernel(trace, at, is_float, _compiled(_source(trace)))   # numba's where installed
@@ -683,9 +686,10 @@ class Kernel:
             out.append(int(per[0]))
         return tuple(out)
 
-    def __call__(self, phi, branches: tuple[int, ...] | None = None) -> dict | None:
+    def __call__(self, phi, branches: tuple[int, ...] | None = None, columns: list = ()) -> dict | None:
         """Kinematics at the input coordinates ``phi`` ``(N,)`` (see :func:`run_kernel`), each group
-        on its planned branch or on ``branches`` (one per group) when given."""
+        on its planned branch or on ``branches`` (one per group) when given; ``columns``: the
+        geometry's ``(N,)`` inputs of a kernel of variants (:mod:`.kernel_variants`)."""
         phi = np.atleast_1d(np.asarray(phi, dtype=float))
         N = len(phi)
         if not N or phi.ndim != 1:
@@ -705,7 +709,7 @@ class Kernel:
         floats = np.empty((self.n_float, N))
         ints = np.empty((1 + len(structure.groups), N), dtype=int)
         floats[:3] = 0.0                               # the frame's pose (never written)
-        inputs = [phi]
+        inputs = [phi, *columns]
         if len(structure.inputs) > 1:
             for q in list(input_angles(mech, structure, phi).values())[1:]:
                 inputs += [np.broadcast_to(np.asarray(v, dtype=float), phi.shape) for v in q]

@@ -397,11 +397,12 @@ def analyze(
 def _kernel_run(mech: Mechanism, phi: np.ndarray, order: int) -> _Run | None:
     """:func:`run_blocks` of every group by the mechanism's compiled kernel
     (:mod:`linkage.kinematics.kernel`: the same numbers), None where it does not apply."""
-    if not USE_KERNEL or not len(phi):
-        return None
-    got = run_kernel(mech, phi, order)
-    if got is None:
-        return None
+    got = run_kernel(mech, phi, order) if USE_KERNEL and len(phi) else None
+    return None if got is None else _kernel_results(got)
+
+
+def _kernel_results(got: dict) -> _Run:
+    """A kernel's results (:func:`linkage.kinematics.kernel.run_kernel`) as a :class:`_Run`."""
     return _Run(got["poses"], got["first"], got["second"], got["status"], got["conditioning"],
                 got["error_bound"], got["signs"], got["solved"], got["points"])
 
