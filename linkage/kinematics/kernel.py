@@ -355,9 +355,8 @@ class _Trace:
             for k, values in masked[name].items():
                 self.outputs += [(f"{name} {k} {c}", v) for c, v in enumerate(values)]
         poses = {k: (f[0], f[1], f[4]) for k, f in frames.items() if k != mech.frame}
-        for point, link in (moving_points(mech) if geometry is None else {}).items():
-            self.outputs += _point(poses[link], masked["first"].get(link), masked["second"].get(link),
-                                   mech.links[link].points[point], point)
+        for j, (link, local) in enumerate(moving_points(mech) if geometry is None else ()):
+            self.outputs += _point(poses[link], masked["first"].get(link), masked["second"].get(link), local, j)
 
     def _inputs(self, mech, structure, order, params):
         """:func:`linkage.kinematics.inputs.input_state` on symbols: the frames and the analogs
@@ -390,16 +389,19 @@ class _Trace:
         return frames, first, second
 
 
-def moving_points(mech: Mechanism) -> dict[str, str]:
-    """Each named point that a moving link reports (:meth:`Mechanism.point_link`) -> that link."""
-    owners = {p: mech.point_link(p) for p in mech.point_names}
-    return {p: k for p, k in owners.items() if k != mech.frame}
+def moving_points(mech: Mechanism) -> list[tuple[str, tuple[float, float]]]:
+    """``(link, local point)`` of each named point that a moving link reports
+    (:meth:`Mechanism.point_link`) and of each moving link's centre of mass (the kinetostatics'),
+    each once."""
+    out = [(mech.point_link(p), mech.links[mech.point_link(p)].points[p]) for p in mech.point_names]
+    out += [(k, mech.links[k].center_of_mass) for k in mech.moving_links]
+    return list(dict.fromkeys((k, tuple(float(c) for c in local)) for k, local in out if k != mech.frame))
 
 
-def _point(pose, first, second, local, name: str) -> list[tuple[str, Any]]:
-    """:meth:`linkage.kinematics.motion.Motion.point` and ``point_analogs`` on symbols (the link's
-    cosines and sines of its angle, as :func:`assur.rows.frame` takes them): the outputs
-    ``point P c``, ``point first P c``, ``point second P c``."""
+def _point(pose, first, second, local, name: int) -> list[tuple[str, Any]]:
+    """:meth:`linkage.kinematics.motion.Motion.local_point` on symbols (the link's cosines and sines
+    of its angle, as :func:`assur.rows.frame` takes them): the outputs ``point P c``,
+    ``point first P c``, ``point second P c`` of the ``P``-th point."""
     x, y, theta = pose
     (px, py), c, s = xy(local), np.cos(theta), np.sin(theta)
     rx, ry = c * px - s * py, s * px + c * py
@@ -637,9 +639,9 @@ class Kernel:
             for k in links:
                 for c in range(3):
                     rows[f"{kind} {k} {c}"] = (True, len(rows))
-        self.points = list(moving_points(mech)) if geometry is None else []
+        self.points = moving_points(mech) if geometry is None else []
         for kind in ("point", "point first", "point second")[:order + 1]:
-            for point in self.points:
+            for point in range(len(self.points)):
                 for c in range(2):
                     rows[f"{kind} {point} {c}"] = (True, len(rows))
         n_groups = len(structure.groups)
@@ -730,8 +732,8 @@ class Kernel:
                 {k: floats[j * step + 3 * i:j * step + 3 * i + 3].T for i, k in enumerate(self.links)}
         start = (self.order + 1) * step
         points = {}
-        for point in self.points:
-            at = [start + 2 * (j * len(self.points) + self.points.index(point)) for j in range(self.order + 1)]
+        for i, point in enumerate(self.points):
+            at = [start + 2 * (j * len(self.points) + i) for j in range(self.order + 1)]
             points[point] = tuple(floats[r:r + 2].T for r in at) + (None,) * (2 - self.order)
         result["points"] = points
         start += 2 * (self.order + 1) * len(self.points)

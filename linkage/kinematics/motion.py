@@ -99,10 +99,16 @@ class Motion:
     def arm(self, link: str, local) -> np.ndarray:
         """``Rot(theta) p`` ``(N, 2)``, m: the vector from ``link``'s origin to its local point
         ``p`` (``(2,)``, or ``(N, 2)`` per position) in global axes, the link's cosines and sines
-        computed once per motion."""
+        computed once per motion (and the arm of a ``(2,)`` point too: do not write into it)."""
+        key = ("arm", link, tuple(float(c) for c in local)) if np.ndim(local) == 1 else None
+        if key in self._turns:
+            return self._turns[key]
         _, _, c, s, _ = self.frame(link)
         px, py = xy(local)
-        return np.column_stack([c * px - s * py, s * px + c * py])
+        arm = np.column_stack([c * px - s * py, s * px + c * py])
+        if key is not None:
+            self._turns[key] = arm
+        return arm
 
     def frame(self, link: str) -> tuple[np.ndarray, ...]:
         """``(x, y, cos theta, sin theta, theta)`` of ``link``, each ``(N,)`` (the solvers' link
@@ -123,35 +129,31 @@ class Motion:
     # -- points, links, slides -----------------------------------------------------------------
     def point(self, name: str) -> np.ndarray:
         """Global position ``(N, 2)`` of a named point, m."""
-        return self._point_values(name)[0]
+        return self.local_point(*self._owner(name))[0]
 
     def point_analogs(self, name: str) -> tuple[np.ndarray, np.ndarray | None]:
         """First and second analogs ``(N, 2)`` of a named point, m/rad and m/rad^2."""
         self._need(1)
-        return self._point_values(name)[1:]
+        return self.local_point(*self._owner(name))[1:]
 
-    def _point_values(self, name: str) -> tuple[np.ndarray, np.ndarray | None, np.ndarray | None]:
-        """Position and first and second analogs of a named point (None beyond the order
-        computed), computed once per motion (by the compiled kernel, where it ran)."""
-        key = ("point values", name)
+    def local_point(self, link: str, local) -> tuple[np.ndarray, np.ndarray | None, np.ndarray | None]:
+        """Global position ``(N, 2)`` and first and second analogs of the point ``local``
+        (``(2,)``, m) fixed in ``link`` (None beyond the order computed), computed once per motion
+        (by the compiled kernel, where it ran, for named points and centres of mass)."""
+        key = ("at", link, tuple(float(c) for c in local))
         if key not in self._turns:
-            link, local, arm = self._point(name)
-            pose = self.poses[link]
+            arm, pose = self.arm(link, local), self.poses[link]
             analogs = (None, None) if self.first is None else \
                 point_analogs(pose, self.first[link], self.second and self.second[link], local, arm)
             self._turns[key] = (pose[:, :2] + arm, *analogs)
         return self._turns[key]
 
-    def _point(self, name: str):
-        """``(link, local point, arm)`` of a named point, the arm computed once per motion."""
-        key = ("point", name)
-        if key not in self._turns:
-            link = self.mechanism.point_link(name)
-            if link not in self.poses:
-                raise InputError(f"point '{name}' (link '{link}') was not among the requested outputs")
-            local = self.mechanism.links[link].points[name]
-            self._turns[key] = (link, local, self.arm(link, local))
-        return self._turns[key]
+    def _owner(self, name: str) -> tuple[str, tuple[float, float]]:
+        """``(link, local point)`` of a named point."""
+        link = self.mechanism.point_link(name)
+        if link not in self.poses:
+            raise InputError(f"point '{name}' (link '{link}') was not among the requested outputs")
+        return link, self.mechanism.links[link].points[name]
 
     def _need(self, order: int) -> None:
         have = 0 if self.first is None else 1 if self.second is None else 2
@@ -162,7 +164,7 @@ class Motion:
         """Value and first / second analogs of ``"P.x"``, ``"P.y"``, ``"L.theta"`` or ``"K.s"``."""
         kind, obj, axis = parse_quantity(self.mechanism, name)
         if kind == "point":
-            return tuple(None if v is None else v[:, axis] for v in self._point_values(obj))
+            return tuple(None if v is None else v[:, axis] for v in self.local_point(*self._owner(obj)))
         if kind == "link":
             first, second = (None if d is None else d[obj][:, 2] for d in (self.first, self.second))
             return self.poses[obj][:, 2], first, second
@@ -390,7 +392,7 @@ def analyze(
                     second if order >= 2 else None, status, omega_arr, eps_arr, run.conditioning,
                     run.error_bound)
     for point, values in (run.points or {}).items():
-        motion._turns["point values", point] = values
+        motion._turns["at", *point] = values
     return motion
 
 

@@ -49,7 +49,7 @@ from typing import Any, Iterable, Mapping, Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
-from assur.base import cross, point_analogs
+from assur.base import cross
 
 from ..errors import InputError, LinkageError, SchemeError
 from ..kinematics.extremes import extreme_positions, table_angles, wrap_angle
@@ -795,8 +795,7 @@ def inertia_terms(motion: Motion, links: Iterable[str] | None = None) -> list[Lo
         link = mech.links[k]
         if k not in wanted or link.mass == 0 and link.inertia == 0:
             continue
-        d1, d2 = point_analogs(motion.poses[k], motion.first[k], motion.second[k], link.center_of_mass,
-                               motion.arm(k, link.center_of_mass))
+        _, d1, d2 = motion.local_point(k, link.center_of_mass)
         acc = d2 * (w**2)[:, None] + d1 * e[:, None]
         eps_k = motion.second[k][:, 2] * w**2 + motion.first[k][:, 2] * e
         terms.append(LoadTerm(k, link.center_of_mass, -link.mass * acc, -link.inertia * eps_k,
