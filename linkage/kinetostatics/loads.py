@@ -808,9 +808,13 @@ def generalized_loads(motion: Motion, terms: Sequence[LoadTerm]) -> dict[str, np
     (zeros for the drivers of cylinder inputs too, which the groups load)."""
 
     n = len(motion.phi)
-    out = {k: np.zeros((n, 3)) for k in [*motion.mechanism.links, *motion.structure.inputs]}
-    for t in terms:
-        out[t.link][:, :2] += t.force
-        out[t.link][:, 2] += cross(motion.arm(t.link, t.local), t.force) + t.moment
+    sums: dict[str, list] = {}
+    for t in terms:     # summed per link in contiguous columns, the terms in their order
+        force = np.asarray(t.force, dtype=float)
+        add = (force[:, 0], force[:, 1], cross(motion.arm(t.link, t.local), force) + t.moment)
+        got = sums.get(t.link)
+        sums[t.link] = [0.0 + a for a in add] if got is None else [a + b for a, b in zip(got, add)]
+    out = {k: np.zeros((n, 3)) for k in [*motion.mechanism.links, *motion.structure.inputs] if k not in sums}
+    out.update({k: np.column_stack(v) for k, v in sums.items()})
     return out
 

@@ -5,11 +5,14 @@ source's reference positions (:mod:`~.assignments`); each assignment's mechanism
 source's geometry, and whether it decomposes into solvable groups (:mod:`~.geometry`); for a
 group solved by Newton's method, the assembly mode of the reference position, followed over a
 turn and declared by a readable condition (:mod:`~.placement`); every solvable assignment checked
-over a full turn and measured, the table and the schemes written (:mod:`~.enumeration`). Reads
+over a full turn and measured, the table and the schemes written (:mod:`~.enumeration`). The
+1-DOF planar chains of N links and their symmetry, for structural synthesis (:mod:`~.chains`). Reads
 every analysis stage and the report's tables. The public API is exported here.
 """
 
 from .assignments import Assignment, PairKind, Reference, assignments, reference_positions
+from .chains import (CHAIN_LINKS, Chain, SynthesisExtraMissing, canonical_form, chains, input_choices, inversions,
+                     link_orbits, rigid_subchain)
 from .enumeration import (
                           COLUMN_UNITS,
                           CRANK_FACTORS,
@@ -23,6 +26,15 @@ from .enumeration import (
 from .placement import MIN_CONDITIONING, build_combination
 
 __all__ = [
+    "CHAIN_LINKS",
+    "Chain",
+    "SynthesisExtraMissing",
+    "canonical_form",
+    "chains",
+    "input_choices",
+    "inversions",
+    "link_orbits",
+    "rigid_subchain",
     "COLUMN_UNITS",
     "CRANK_FACTORS",
     "DEFAULT_OMEGA",
