@@ -83,7 +83,8 @@ def _rem(a, b):
 _INFIX = {"add": "+", "subtract": "-", "multiply": "*", "divide": "/", "less": "<", "less_equal": "<=",
           "greater": ">", "greater_equal": ">=", "equal": "==", "not_equal": "!="}
 _CALL = {"sqrt": "math.sqrt", "hypot": "math.hypot", "arctan2": "math.atan2", "arcsin": "math.asin",
-         "cos": "math.cos", "sin": "math.sin", "absolute": "abs", "sign": "_sign", "remainder": "_rem"}
+         "cos": "math.cos", "sin": "math.sin", "absolute": "abs", "sign": "_sign", "remainder": "_rem",
+         "isfinite": "math.isfinite", "isnan": "math.isnan"}
 
 
 def numba_enabled() -> bool:

@@ -34,6 +34,7 @@ from ..errors import InputError
 from ..kinematics.inputs import input_angles
 from ..kinematics.motion import Motion, angle_in_half_turn
 from .friction import Friction, friction_angle_deg, friction_of, group_with_friction
+from .kernel import input_freedom, run_reactions_kernel
 from .loads import Loads, LoadTerm, evaluate_loads, generalized_loads, inertia_terms, loads_of
 
 __all__ = ["Reactions", "reactions_under", "solve_reactions", "virtual_power_residual"]
@@ -323,6 +324,10 @@ def reactions_under(motion: Motion, terms: list[LoadTerm], pairs: Iterable[str] 
     static = 1.0 if sense is None else float(sense)
     locked_pair = np.full(n, "", dtype=object)
     lost: list[LoadTerm] = []
+    compiled = run_reactions_kernel(motion, applied, valid) if everything and not friction else None
+    if compiled is not None:     # the same steps as below, compiled (kinetostatics/kernel.py)
+        multipliers, balancing = compiled
+        return Reactions(motion, multipliers, balancing[structure.inputs[0]], terms, notes, balancing, sense=static)
     for i in reversed(group_ids):
         group = structure.groups[i]
         frames = {k: motion.frame(k) for k in (*group.links, *group.known_links)}
@@ -413,19 +418,6 @@ def _locked_note(motion: Motion, friction: Friction, locked: np.ndarray, pair: n
                      f"{', '.join(str(r + 1) for r in rows[:6])}{more} ({shown})")
     return ("self-locking: no finite balancing load moves the mechanism against its friction at "
             + "; ".join(parts) + " -- the values there are NaN")
-
-
-def input_freedom(joint, link: str, rows) -> tuple[tuple, tuple]:
-    """The motion an input ``link`` has in its ``joint`` with the frame, per unit of its coordinate
-    (``(vx, vy, w)``: a turn about the pin for a crank, a slide along the guide for a slider), and
-    the generalized load ``(Fx, Fy, M)`` of a unit drive (a unit moment, or a unit force along the
-    slide through the link's origin) -- the drive whose value is the balancing moment or force.
-    ``rows``: :func:`assur.rows.rows_of` of the joint at the motion's frames."""
-    vx, vy, w = rows.null(link)
-    if joint.kind == "R":
-        return (vx, vy, w), (0.0, 0.0, 1.0)
-    sign = 1.0 if link == joint.b else -1.0        # guide on the frame: the link slides along +u
-    return (sign * vx, sign * vy, 0.0), (sign * vx, sign * vy, 0.0)
 
 
 def virtual_power_residual(reactions: Reactions) -> np.ndarray:
