@@ -21,10 +21,11 @@ from assur.base import DrivenPrismaticJoint
 from .errors import StructureError
 from .model.mechanism import Mechanism, Prismatic, Revolute
 
-__all__ = ["Structure", "mobility", "decompose", "structure_of", "joint_of"]
+__all__ = ["Structure", "mobility", "decompose", "structure_of", "joint_of", "group_links"]
 
-#: largest group size searched (class III groups have 4 links)
-MAX_GROUP_LINKS = 4
+#: largest group searched, links (class III groups have 4; a 1-DOF mechanism of 12 links may hold
+#: one of 10, solved by Newton's method)
+MAX_GROUP_LINKS = 10
 
 
 @dataclass(frozen=True)
@@ -200,21 +201,31 @@ def _is_group(subset, known, joints, used) -> bool:
     return True
 
 
-def _next_group(unknown, known, joints, used, size) -> Group | None:
-    for n in range(1, MAX_GROUP_LINKS + 1):     # odd sizes only hold a driven pair (three equations)
+def group_links(unknown, known, joints, used) -> tuple[str, ...] | None:
+    """The links of the Assur group :func:`decompose` takes next: the smallest set of the
+    ``unknown`` links (sorted names) that forms a group on the ``known`` links over the pairs
+    ``joints`` not yet ``used`` (the first of :func:`itertools.combinations` among sets of one
+    size), of at most :data:`MAX_GROUP_LINKS` links; None when there is none."""
+    for n in range(1, min(MAX_GROUP_LINKS, len(unknown)) + 1):   # odd sizes only hold a driven pair
         for subset in combinations(unknown, n):
-            if not _is_group(subset, known, joints, used):
-                continue
-            solver = solver_for(subset, _group_joints(subset, known, joints, used), known, size)
-            if solver is None:
-                raise StructureError(
-                    f"links {list(subset)} form a group with pairs "
-                    f"{[_describe(j) for j in _group_joints(subset, known, joints, used)]} "
-                    "but no registered solver handles it (kinds: RRR, RRP, RPR, PRP, RPP with the "
-                    "guide of each external prismatic pair on the known link)"
-                )
-            return solver
+            if _is_group(subset, known, joints, used):
+                return subset
     return None
+
+
+def _next_group(unknown, known, joints, used, size) -> Group | None:
+    subset = group_links(unknown, known, joints, used)
+    if subset is None:
+        return None
+    solver = solver_for(subset, _group_joints(subset, known, joints, used), known, size)
+    if solver is None:
+        raise StructureError(
+            f"links {list(subset)} form a group with pairs "
+            f"{[_describe(j) for j in _group_joints(subset, known, joints, used)]} "
+            "but no registered solver handles it (kinds: RRR, RRP, RPR, PRP, RPP with the "
+            "guide of each external prismatic pair on the known link)"
+        )
+    return solver
 
 
 def _describe(j) -> str:

@@ -16,6 +16,7 @@
     linkage enumerate SCHEME [--out DIR]              every R/P assignment of the chain's pairs
     linkage plans SCHEME --position I [--omega W | --rpm R] [--eps E] [--format json|svg|png]
                          [--out DIR]                 plans, force polygons, Zhukovsky's lever
+    linkage synthesize --links N [--out DIR] [--with-geometry] ...   every 1-DOF mechanism of N links
 
 Every scheme argument takes ``--input-law LINK:LAW`` for the further inputs of a mechanism with
 several (docs/inputs.md).
@@ -51,7 +52,7 @@ from typing import Callable, Sequence
 from ..errors import LinkageError
 from ..report.results import NUMERICAL_WARNING
 from ..version import __version__
-from . import analyze, dynamics, enumeration, forces, grade, plans, report, schemes, sheets, variants
+from . import analyze, dynamics, enumeration, forces, grade, plans, report, schemes, sheets, synthesize, variants
 from .options import CONVENTIONS, EXIT_INPUT, EXIT_INTERNAL, PROG, SAID, HelpFormatter, error_lines, note
 
 __all__ = ["main", "build_parser", "COMMANDS", "EXIT_INPUT", "EXIT_INTERNAL"]
@@ -60,7 +61,7 @@ __all__ = ["main", "build_parser", "COMMANDS", "EXIT_INPUT", "EXIT_INTERNAL"]
 #: functions that register one subcommand each, in the order ``--help`` lists them
 COMMANDS: list[Callable] = [schemes.add, analyze.add, forces.add, dynamics.add, report.add, sheets.add, variants.add,
                             grade.add,
-                            enumeration.add, plans.add]
+                            enumeration.add, plans.add, synthesize.add]
 
 
 def build_parser() -> argparse.ArgumentParser:

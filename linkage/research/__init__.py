@@ -6,7 +6,9 @@ source's geometry, and whether it decomposes into solvable groups (:mod:`~.geome
 group solved by Newton's method, the assembly mode of the reference position, followed over a
 turn and declared by a readable condition (:mod:`~.placement`); every solvable assignment checked
 over a full turn and measured, the table and the schemes written (:mod:`~.enumeration`). The
-1-DOF planar chains of N links and their symmetry, for structural synthesis (:mod:`~.chains`). Reads
+1-DOF planar chains of N links and their symmetry (:mod:`~.chains`); every mechanism of N links, its
+Assur groups and the catalogue of groups (:mod:`~.synthesis`), a geometry that turns fully and the
+atlas written (:mod:`~.synthesis_geometry`). Reads
 every analysis stage and the report's tables. The public API is exported here.
 """
 
@@ -24,9 +26,16 @@ from .enumeration import (
                           measure,
 )
 from .placement import MIN_CONDITIONING, build_combination
+from .synthesis import GroupCount, GroupUse, Topology, catalogue, mechanisms, topology
 
 __all__ = [
     "CHAIN_LINKS",
+    "GroupCount",
+    "GroupUse",
+    "Topology",
+    "catalogue",
+    "mechanisms",
+    "topology",
     "Chain",
     "SynthesisExtraMissing",
     "canonical_form",

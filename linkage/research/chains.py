@@ -3,7 +3,7 @@
 A chain with revolute pairs is a graph: its links are vertices, its pairs edges. Chebyshev's count
 for one degree of freedom, ``3(n - 1) - 2p = 1``, allows n = 4, 6, 8, 10, 12 links with
 p = (3n - 4)/2 = 4, 7, 10, 13, 16 pairs. :func:`chains` lists every non-isomorphic such chain with
-no rigid sub-chain (METHOD.md section 12), by the classical route:
+no rigid sub-chain (docs/synthesis.md), by the classical route:
 
 1. *link assortments*: the numbers ``(n2, n3, ...)`` of binary, ternary ... links with
    ``sum n_k = n`` and ``sum k n_k = 2p``;
