@@ -117,6 +117,22 @@ def test_six_link_geometries_load_turn_fully_and_close(tmp_path):
         assert search_geometry(t, seed=3).scheme == result.scheme          # reproducible
 
 
+def test_an_eight_link_mechanism_of_one_six_link_group_loads_turns_fully_and_closes(tmp_path):
+    """8.15 with link 4 as the frame and 0 as the crank: one class-V group of six links, solved by
+    Newton's method (decompose searches groups of up to MAX_GROUP_LINKS = 10 links)."""
+    (t,) = [t for t in mechanisms(8) if t.id == "8.15-f4-c0"]
+    assert [len(g.links) for g in t.groups] == [6] and MAX_GROUP_LINKS >= 6
+    result = search_geometry(t, seed=0)
+    assert result.found, result.note
+    path = tmp_path / f"{t.id}.toml"
+    path.write_text(result.scheme)
+    mech = linkage.load(path)
+    assert linkage.structure.structure_of(mech).formula == t.formula
+    motion = linkage.analyze(mech, np.radians(np.arange(0.0, 360.0, 2.0)))
+    assert np.all(motion.status == 0)
+    assert _closure(mech, motion) <= 1e-9 * mech.size
+
+
 def test_workers_give_the_same_schemes():
     found = mechanisms(6)[:3]
     assert [r.scheme for r in search_all(found, 5, workers=2)] == [r.scheme for r in search_all(found, 5)]
