@@ -60,9 +60,13 @@ def general(mech, phi, order, branches=None):
             analogs = (None, None) if order == 0 else \
                 point_analogs(pose, run.first[link], run.second and run.second[link], local)
             points[link, tuple(local)] = (global_point(pose, local), *analogs)
+    scales = {}     # each group's length scale where it is assembled (Group.scale)
+    for i, group in enumerate(structure.groups):
+        with np.errstate(invalid="ignore"):
+            scales[i] = np.where(run.solved[i] != -1, group.scale(run.poses), np.nan)
     return {"poses": run.poses, "first": run.first, "second": run.second, "status": run.status,
             "conditioning": run.conditioning, "error_bound": run.error_bound, "signs": run.signs,
-            "solved": run.solved, "points": points}
+            "solved": run.solved, "points": points, "scales": scales}
 
 
 def assert_same(got: dict, ref: dict, size: float, what: str) -> None:
@@ -84,6 +88,8 @@ def assert_same(got: dict, ref: dict, size: float, what: str) -> None:
         for link, value in ref[name].items():
             scale = np.abs(value) + np.array([size, size, 1.0])
             _close(got[name][link], value, TOL * scale, f"{what}: {name} of link {link}")
+    for i, scale in ref["scales"].items():     # the jump check's weight of turns: from other round-off
+        _close(got["scales"][i], scale, 1e-9 * np.abs(scale), f"{what}: scale of group {i}")
     assert set(got["points"]) == set(ref["points"]), f"{what}: the points"
     for point, values in ref["points"].items():
         for name, value, mine in zip(("position", "first analog", "second analog"), values, got["points"][point]):

@@ -340,7 +340,7 @@ class _Trace:
             for k in group.links:
                 errors[k] = got["bound"]
             self.outputs += [(f"conditioning {i}", got["conditioning"]), (f"sign {i}", got["sign"]),
-                             (f"solved {i}", got["status"])]
+                             (f"scale {i}", got["scale"]), (f"solved {i}", got["status"])]
             for k, pose in got["poses"].items():
                 self.outputs += [(f"pose {k} {c}", v) for c, v in enumerate(pose)]
             status = np.where(status == OK, got["status"], status)
@@ -471,7 +471,8 @@ def _solve_dyad(group, frames, first, second, branch, input_error, order) -> dic
             bad = status != OK      # the solve's NaN where not OK, then where flagged: the same
             second[l1], second[l2] = (tuple(np.where(bad, np.nan, v) for v in a) for a in (a1, a2))
         first[l1], first[l2] = (tuple(np.where(bad, np.nan, v) for v in q) for q in (q1, q2))
-    return {"poses": poses, "status": status, "sign": sign, "conditioning": conditioning, "bound": bound}
+    return {"poses": poses, "status": status, "sign": sign, "conditioning": conditioning, "bound": bound,
+            "scale": np.where(assembled, scale, np.nan)}
 
 
 def _error_bound(ratio, input_error, factor):
@@ -624,7 +625,7 @@ class Kernel:
     :func:`run_kernel`, or None where a group's branch changes between the positions.
 
     The results are rows of two arrays allocated per call: one ``(R, N)`` of floats (poses and
-    analogs, three rows per link, then each group's conditioning and sign and the error bound)
+    analogs, three rows per link, then each group's conditioning, sign and scale and the error bound)
     and one ``(G + 1, N)`` of ints (the status, each group's own status); the dicts hold views.
     """
 
@@ -648,6 +649,7 @@ class Kernel:
         for i in range(n_groups):
             rows[f"conditioning {i}"] = (True, len(rows))
             rows[f"sign {i}"] = (True, len(rows))
+            rows[f"scale {i}"] = (True, len(rows))
         rows["error"] = (True, len(rows))
         self.n_float = len(rows)
         rows["status"] = (False, 0)
@@ -738,8 +740,9 @@ class Kernel:
         result["points"] = points
         start += 2 * (self.order + 1) * len(self.points)
         groups = structure.groups
-        result["conditioning"] = {repr(g): floats[start + 2 * i] for i, g in enumerate(groups)}
-        result["signs"] = {i: floats[start + 2 * i + 1] for i in range(len(groups))}
+        result["conditioning"] = {repr(g): floats[start + 3 * i] for i, g in enumerate(groups)}
+        result["signs"] = {i: floats[start + 3 * i + 1] for i in range(len(groups))}
+        result["scales"] = {i: floats[start + 3 * i + 2] for i in range(len(groups))}
         result["error_bound"] = floats[-1]
         result["status"] = ints[0]
         result["solved"] = {i: ints[1 + i] for i in range(len(groups))}
@@ -778,8 +781,9 @@ def run_kernel(mech: Mechanism, phi, order: int = 2) -> dict | None:
     dict or None
         ``poses``, ``first``, ``second``: link -> ``(N, 3)`` (None above ``order``); ``status``
         ``(N,)`` int; ``conditioning``: group label -> ``(N,)``; ``error_bound`` ``(N,)``;
-        ``signs``, ``solved``: group index -> the sign of its Jacobian's determinant and its own
-        status ``(N,)``; ``branches``: each group's branch; ``points``: each point that a moving
+        ``signs``, ``scales``, ``solved``: group index -> the sign of its Jacobian's determinant,
+        its own length scale (m, :meth:`assur.base.Group.scale`; NaN where it is not assembled) and
+        its own status ``(N,)``; ``branches``: each group's branch; ``points``: each point that a moving
         link reports -> its position and first and second analogs, each ``(N, 2)`` (None above
         ``order``). None where the kernel does not apply
         (:func:`kernel_for`) or a group's branch changes among ``phi``: run the general path.

@@ -379,7 +379,8 @@ def analyze(
         _check_continuity(group, run.signs[i], plans[i].branches(phi), run.solved[i], phi, mech.coordinate)
         _check_change_points(group, plans[i], phi, mech.coordinate)
         if order >= 1:
-            _check_jumps(group, plans[i], run.poses, run.first, run.solved[i], phi, mech.coordinate)
+            _check_jumps(group, plans[i], run.poses, run.first, run.solved[i], phi, mech.coordinate,
+                         None if run.scales is None else run.scales[i])
     status, bad = run.status, run.status != OK
     if on_failure == "raise" and bad.any():
         raise _failure(mech, phi, run, structure, plans, list(group_ids))
@@ -406,7 +407,7 @@ def _kernel_run(mech: Mechanism, phi: np.ndarray, order: int) -> _Run | None:
 def _kernel_results(got: dict) -> _Run:
     """A kernel's results (:func:`linkage.kinematics.kernel.run_kernel`) as a :class:`_Run`."""
     return _Run(got["poses"], got["first"], got["second"], got["status"], got["conditioning"],
-                got["error_bound"], got["signs"], got["solved"], got["points"])
+                got["error_bound"], got["signs"], got["solved"], got["points"], got["scales"])
 
 
 def _check_law_domains(mech: Mechanism, phi: np.ndarray) -> None:
@@ -472,6 +473,7 @@ class _Run:
     signs: dict[int, np.ndarray]     # group index -> sign of its Jacobian determinant (N,)
     solved: dict[int, np.ndarray]    # group index -> the group's own status (N,)
     points: dict[str, tuple] | None = None   # the kernel's: point -> position, first, second analogs (N, 2)
+    scales: dict[int, np.ndarray] | None = None   # the kernel's: group index -> its length scale (N,), m
 
 
 def run_blocks(mech: Mechanism, structure: Structure, plans, group_ids: list[int], phi: np.ndarray,
@@ -647,12 +649,12 @@ def _check_change_points(group, plan, phi, coordinate) -> None:
 JUMP_CHECK_STEP = np.pi / 18
 
 
-def _check_jumps(group, plan, poses, first, status, phi, coordinate) -> None:
+def _check_jumps(group, plan, poses, first, status, phi, coordinate, scales: np.ndarray | None = None) -> None:
     """Warn where a group moves between two analysed angles (at most 10 deg apart) by more than
     its first analogs allow: the displacement of points fixed in its links differs from the
     trapezoid rule on their analogs by more than half of either (a change point or a singular
     position passed between the angles, with no other warning). Checked :data:`BLOCK` steps at
-    a time."""
+    a time; ``scales``: the group's length scale per position where the kernel gave it."""
     if len(phi) < 2:
         return
     dphi = np.diff(phi)
@@ -664,7 +666,8 @@ def _check_jumps(group, plan, poses, first, status, phi, coordinate) -> None:
         return
     sample = np.flatnonzero(status == OK)
     sample = sample[:: max(1, len(sample) // 4096)]
-    scale = float(np.median(group.scale({k: v[sample] for k, v in poses.items()})))
+    scale = float(np.median(group.scale({k: v[sample] for k, v in poses.items()}) if scales is None
+                            else scales[sample]))
     bad = jump_steps(group, poses, first, pairs, dphi, scale)
     if bad.any():
         k = np.flatnonzero(bad)
