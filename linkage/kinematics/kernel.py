@@ -32,7 +32,7 @@ that change between the requested positions), and the general path is the answer
 from __future__ import annotations
 
 import weakref
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from typing import Any
 
 import numpy as np
@@ -641,6 +641,9 @@ class Kernel:
                 for c in range(3):
                     rows[f"{kind} {k} {c}"] = (True, len(rows))
         self.points = moving_points(mech) if geometry is None else []
+        first_point = 3 * len(links) * (order + 1)
+        self._point_rows = {point: [first_point + 2 * (j * len(self.points) + i) for j in range(order + 1)]
+                            for i, point in enumerate(self.points)}
         for kind in ("point", "point first", "point second")[:order + 1]:
             for point in range(len(self.points)):
                 for c in range(2):
@@ -733,11 +736,7 @@ class Kernel:
             result[name] = None if j > self.order else \
                 {k: floats[j * step + 3 * i:j * step + 3 * i + 3].T for i, k in enumerate(self.links)}
         start = (self.order + 1) * step
-        points = {}
-        for i, point in enumerate(self.points):
-            at = [start + 2 * (j * len(self.points) + i) for j in range(self.order + 1)]
-            points[point] = tuple(floats[r:r + 2].T for r in at) + (None,) * (2 - self.order)
-        result["points"] = points
+        result["points"] = PointRows(floats, self._point_rows, self.order)
         start += 2 * (self.order + 1) * len(self.points)
         groups = structure.groups
         result["conditioning"] = {repr(g): floats[start + 3 * i] for i, g in enumerate(groups)}
@@ -748,6 +747,24 @@ class Kernel:
         result["solved"] = {i: ints[1 + i] for i in range(len(groups))}
         result["branches"] = branches
         return result
+
+
+class PointRows(Mapping):
+    """The points of a kernel's results, ``(link, local point)`` -> position and first and second
+    analogs ``(N, 2)`` (None above the order), as views of its rows made when asked."""
+
+    def __init__(self, floats: np.ndarray, rows: dict, order: int):
+        self._floats, self._rows, self._order = floats, rows, order
+
+    def __getitem__(self, key):
+        floats = self._floats
+        return tuple(floats[r:r + 2].T for r in self._rows[key]) + (None,) * (2 - self._order)
+
+    def __iter__(self):
+        return iter(self._rows)
+
+    def __len__(self) -> int:
+        return len(self._rows)
 
 
 _KERNELS: dict[int, tuple[weakref.ref, dict[int, Kernel | None]]] = {}

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import warnings
 from dataclasses import dataclass, field
-from typing import Iterable, Literal
+from typing import Iterable, Literal, Mapping
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -140,20 +140,28 @@ class Motion:
         """Global position ``(N, 2)`` and first and second analogs of the point ``local``
         (``(2,)``, m) fixed in ``link`` (None beyond the order computed), computed once per motion
         (by the compiled kernel, where it ran, for named points and centres of mass)."""
-        key = ("at", link, tuple(float(c) for c in local))
-        if key not in self._turns:
-            arm, pose = self.arm(link, local), self.poses[link]
-            analogs = (None, None) if self.first is None else \
-                point_analogs(pose, self.first[link], self.second and self.second[link], local, arm)
-            self._turns[key] = (pose[:, :2] + arm, *analogs)
-        return self._turns[key]
+        key = ("at", link, (float(local[0]), float(local[1])))
+        got = self._turns.get(key)
+        if got is None:
+            kernel = self._turns.get("kernel points")     # linkage.kinematics.kernel.PointRows
+            got = kernel.get(key[1:]) if kernel is not None else None
+            if got is None:
+                arm, pose = self.arm(link, local), self.poses[link]
+                analogs = (None, None) if self.first is None else \
+                    point_analogs(pose, self.first[link], self.second and self.second[link], local, arm)
+                got = (pose[:, :2] + arm, *analogs)
+            self._turns[key] = got
+        return got
 
     def _owner(self, name: str) -> tuple[str, tuple[float, float]]:
         """``(link, local point)`` of a named point."""
-        link = self.mechanism.point_link(name)
-        if link not in self.poses:
-            raise InputError(f"point '{name}' (link '{link}') was not among the requested outputs")
-        return link, self.mechanism.links[link].points[name]
+        got = self._turns.get(("owner", name))
+        if got is None:
+            link = self.mechanism.point_link(name)
+            if link not in self.poses:
+                raise InputError(f"point '{name}' (link '{link}') was not among the requested outputs")
+            got = self._turns["owner", name] = (link, self.mechanism.links[link].points[name])
+        return got
 
     def _need(self, order: int) -> None:
         have = 0 if self.first is None else 1 if self.second is None else 2
@@ -392,8 +400,8 @@ def analyze(
     motion = Motion(mech, structure, phi, poses, first if order >= 1 else None,
                     second if order >= 2 else None, status, omega_arr, eps_arr, run.conditioning,
                     run.error_bound)
-    for point, values in (run.points or {}).items():
-        motion._turns["at", *point] = values
+    if run.points is not None:
+        motion._turns["kernel points"] = run.points
     return motion
 
 
@@ -472,7 +480,7 @@ class _Run:
     error_bound: np.ndarray
     signs: dict[int, np.ndarray]     # group index -> sign of its Jacobian determinant (N,)
     solved: dict[int, np.ndarray]    # group index -> the group's own status (N,)
-    points: dict[str, tuple] | None = None   # the kernel's: point -> position, first, second analogs (N, 2)
+    points: Mapping | None = None   # the kernel's: (link, local point) -> position, first, second analogs (N, 2)
     scales: dict[int, np.ndarray] | None = None   # the kernel's: group index -> its length scale (N,), m
 
 
@@ -659,6 +667,8 @@ def _check_jumps(group, plan, poses, first, status, phi, coordinate, scales: np.
         return
     dphi = np.diff(phi)
     largest = JUMP_CHECK_STEP * (1.0 if plan.period is not None else float(np.max(group.size)))
+    if np.min(np.abs(dphi)) > largest:        # every step too coarse to tell a jump from a fast motion
+        return
     pairs = (status[:-1] == OK) & (status[1:] == OK) & (np.abs(dphi) <= largest) & (dphi != 0)
     if plan.mode == "keep" and len(plan.change_points):        # passed change points: reported
         pairs &= ~plan.crossed(phi).any(axis=0)
