@@ -15,6 +15,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from itertools import combinations
 
+import numpy as np
+
 from assur import Group, PrismaticJoint, RevoluteJoint, solver_for
 from assur.base import DrivenPrismaticJoint
 
@@ -205,12 +207,53 @@ def group_links(unknown, known, joints, used) -> tuple[str, ...] | None:
     """The links of the Assur group :func:`decompose` takes next: the smallest set of the
     ``unknown`` links (sorted names) that forms a group on the ``known`` links over the pairs
     ``joints`` not yet ``used`` (the first of :func:`itertools.combinations` among sets of one
-    size), of at most :data:`MAX_GROUP_LINKS` links; None when there is none."""
+    size), of at most :data:`MAX_GROUP_LINKS` links; None when there is none. Up to
+    :data:`MASK_LINKS` unknown links every subset is counted at once (:func:`_group_by_masks`),
+    beyond that set by set."""
+    if len(unknown) <= MASK_LINKS:
+        return _group_by_masks(list(unknown), known, joints, used)
     for n in range(1, min(MAX_GROUP_LINKS, len(unknown)) + 1):   # odd sizes only hold a driven pair
         for subset in combinations(unknown, n):
             if _is_group(subset, known, joints, used):
                 return subset
     return None
+
+
+#: most unknown links whose subsets :func:`group_links` counts all at once (2**16 subsets)
+MASK_LINKS = 16
+
+
+def _group_by_masks(unknown: list[str], known, joints, used) -> tuple[str, ...] | None:
+    """:func:`group_links` over every subset of ``unknown`` as a bit mask: each subset's equations
+    (the rows of the unused pairs that touch it and join it or the known links), then the
+    subsets with ``3 n`` equations of which no proper subset has ``3 n`` or more."""
+    m = len(unknown)
+    bit = {k: 1 << i for i, k in enumerate(unknown)}
+    masks = np.arange(1 << m)
+    rows = np.zeros(1 << m, dtype=np.int64)
+    for name, j in joints.items():
+        if name in used or (j.a not in bit and j.b not in bit):
+            continue
+        if not all(k in bit or k in known for k in (j.a, j.b)):
+            continue
+        inside = [np.ones(1 << m, bool) if k in known else (masks & bit[k]) != 0 for k in (j.a, j.b)]
+        rows += j.rows * (inside[0] & inside[1])
+    size = np.bitwise_count(masks.astype(np.uint64)).astype(np.int64)
+    over = (rows >= 3 * size) & (size > 0)          # no group may hold one of these as a proper part
+    within = over.copy()                            # over[T] for some T within S (S itself too)
+    for i in range(m):
+        has = (masks & (1 << i)) != 0
+        within[has] |= within[masks[has] ^ (1 << i)]
+    proper = np.zeros(1 << m, bool)                 # over[T] for some T strictly within S
+    for i in range(m):
+        has = (masks & (1 << i)) != 0
+        proper[has] |= within[masks[has] ^ (1 << i)]
+    found = np.flatnonzero((rows == 3 * size) & (size > 0) & (size <= MAX_GROUP_LINKS) & ~proper)
+    if not len(found):
+        return None
+    smallest = size[found].min()
+    first = min(tuple(i for i in range(m) if x >> i & 1) for x in found[size[found] == smallest])
+    return tuple(unknown[i] for i in first)
 
 
 def _next_group(unknown, known, joints, used, size) -> Group | None:

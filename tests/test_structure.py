@@ -596,3 +596,43 @@ def test_scale_invariance(name, k):
         np.testing.assert_allclose(r, k * s, rtol=1e-12, atol=tol, err_msg=q)
         np.testing.assert_allclose(r1, k * s1 / per, rtol=1e-12, atol=tol / per, err_msg=q + "'")
         np.testing.assert_allclose(r2, k * s2 / per**2, rtol=1e-12, atol=tol / per**2, err_msg=q + "''")
+
+
+def test_the_subset_masks_choose_the_group_the_set_by_set_search_chooses(monkeypatch):
+    """``group_links`` counts every subset of up to MASK_LINKS unknown links at once; the set by
+    set search (combinations, the rule's own statement) must pick the same group at every step of
+    every 8-link mechanism of the synthesis (groups of 2 to 6 links) and of every shipped scheme
+    (driven pairs and prismatic pairs among them)."""
+    import linkage.structure as S
+    from assur import RevoluteJoint
+    from linkage.research.synthesis import mechanisms
+
+    def both(unknown, known, joints, used):
+        fast = S.group_links(unknown, known, joints, used)
+        monkeypatch.setattr(S, "MASK_LINKS", -1)
+        slow = S.group_links(unknown, known, joints, used)
+        monkeypatch.setattr(S, "MASK_LINKS", 16)
+        assert fast == slow, (unknown, sorted(known), fast, slow)
+        return fast
+
+    steps = 0
+    for t in mechanisms(8):
+        pairs = list(t.pairs)       # (pair, link, link)
+        joints = {p: RevoluteJoint(p, a, b, (0.0, 0.0), (0.0, 0.0)) for p, a, b in pairs}
+        known = {"0", "1"}
+        used = {p for p, a, b in pairs if {a, b} == known}
+        unknown = sorted({x for _, a, b in pairs for x in (a, b)} - known)
+        while unknown:
+            group = both(unknown, known, joints, used)
+            assert group is not None
+            steps += 1
+            known |= set(group)
+            used |= {p for p, a, b in pairs if a in known and b in known}
+            unknown = [k for k in unknown if k not in known]
+    assert steps > 153
+    for name in linkage.shipped_schemes():
+        mech = linkage.load(name)
+        monkeypatch.setattr(S, "MASK_LINKS", -1)
+        slow = S.decompose(mech).formula
+        monkeypatch.setattr(S, "MASK_LINKS", 16)
+        assert S.decompose(mech).formula == slow, name
