@@ -182,34 +182,42 @@ class Dyad(Group):
         """
         l1, l2 = self.links
         frames = {k: frame(poses[k]) for k in (l1, l2, *self.known_links)} if frames is None else frames
+        with np.errstate(invalid="ignore", over="ignore"):
+            ok, lam, transmitted = self._transposed(frames, {k: _columns(loads[k]) for k in (l1, l2)},
+                                                    True if valid is None else np.asarray(valid, bool))
+        multipliers = {name: _pose_array(v, ~ok) for name, v in lam.items()}
+        transmitted = {k: _pose_array(v, ~ok) for k, v in transmitted.items()}
+        return multipliers, transmitted
+
+    def _transposed(self, frames, loads, valid):
+        """The elimination of :meth:`reactions` on the links' ``frames`` and the loads on the
+        group's links (link -> ``(Fx, Fy, M)`` columns): where its 2x2 system is regular and
+        ``valid``, the multipliers (pair -> columns) and the loads on the known links (link ->
+        ``(Fx, Fy, M)``); written on columns, so that the compiled reactions
+        (:mod:`linkage.kinetostatics.kernel`) trace it as it is."""
+        l1, l2 = self.links
         ext1, inner, ext2 = [rows_of(j, frames) for j in self.joints]
         n1, n2 = ext1.null(l1), ext2.null(l2)
         c1, c2 = inner.act(l1, n1), inner.act(l2, n2)
         det = c1[0] * c2[1] - c1[1] * c2[0]
-        with np.errstate(invalid="ignore"):
-            ok = np.isfinite(det) & (det != 0)
-        if valid is not None:
-            ok &= np.asarray(valid, bool)
+        ok = np.isfinite(det) & (det != 0) & valid
         det = np.where(ok, det, 1.0)
-        q1, q2 = _columns(loads[l1]), _columns(loads[l2])
-        with np.errstate(invalid="ignore", over="ignore"):
-            b1 = -(n1[0] * q1[0] + n1[1] * q1[1] + n1[2] * q1[2])
-            b2 = -(n2[0] * q2[0] + n2[1] * q2[1] + n2[2] * q2[2])
-            lam_inner = ((b1 * c2[1] - b2 * c1[1]) / det, (c1[0] * b2 - c2[0] * b1) / det)
-            lam = {}
-            for r, link, q in ((ext1, l1, q1), (ext2, l2, q2)):
-                carried = inner.constraint_load(link, lam_inner)
-                lam[r] = r.multipliers(link, tuple(-a - b for a, b in zip(q, carried)))
-            lam[inner] = lam_inner
-            transmitted = {}
-            for r in (ext1, ext2):
-                known = r.links[0] if r.links[1] in self.links else r.links[1]
-                load = r.constraint_load(known, lam[r])
-                old = transmitted.get(known)
-                transmitted[known] = load if old is None else tuple(a + b for a, b in zip(old, load))
-        multipliers = {r.joint.name: _pose_array(lam[r], ~ok) for r in (ext1, inner, ext2)}
-        transmitted = {k: _pose_array(v, ~ok) for k, v in transmitted.items()}
-        return multipliers, transmitted
+        q1, q2 = loads[l1], loads[l2]
+        b1 = -(n1[0] * q1[0] + n1[1] * q1[1] + n1[2] * q1[2])
+        b2 = -(n2[0] * q2[0] + n2[1] * q2[1] + n2[2] * q2[2])
+        lam_inner = ((b1 * c2[1] - b2 * c1[1]) / det, (c1[0] * b2 - c2[0] * b1) / det)
+        lam = {}
+        for r, link, q in ((ext1, l1, q1), (ext2, l2, q2)):
+            carried = inner.constraint_load(link, lam_inner)
+            lam[r] = r.multipliers(link, tuple(-a - b for a, b in zip(q, carried)))
+        lam[inner] = lam_inner
+        transmitted = {}
+        for r in (ext1, ext2):
+            known = r.links[0] if r.links[1] in self.links else r.links[1]
+            load = r.constraint_load(known, lam[r])
+            old = transmitted.get(known)
+            transmitted[known] = load if old is None else tuple(a + b for a, b in zip(old, load))
+        return ok, {r.joint.name: lam[r] for r in (ext1, inner, ext2)}, transmitted
 
     # -- positions -----------------------------------------------------------------------------
     def _position(self, poses, branch):

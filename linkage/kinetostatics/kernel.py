@@ -93,33 +93,12 @@ class _ReactionsTrace(_Trace):
 
 
 def _group_reactions(group, frames, applied, valid):
-    """:meth:`assur.dyad.Dyad.reactions` on symbols: the multipliers of the group's pairs and the
-    loads transmitted to its known links, NaN where the group's system is singular or the
-    position not valid."""
-    l1, l2 = group.links
-    ext1, inner, ext2 = [rows_of(j, frames) for j in group.joints]
-    n1, n2 = ext1.null(l1), ext2.null(l2)
-    c1, c2 = inner.act(l1, n1), inner.act(l2, n2)
-    det = c1[0] * c2[1] - c1[1] * c2[0]
-    ok = np.isfinite(det) & (det != 0) & valid
-    det = np.where(ok, det, 1.0)
-    q1, q2 = applied[l1], applied[l2]
-    b1 = -(n1[0] * q1[0] + n1[1] * q1[1] + n1[2] * q1[2])
-    b2 = -(n2[0] * q2[0] + n2[1] * q2[1] + n2[2] * q2[2])
-    lam_inner = ((b1 * c2[1] - b2 * c1[1]) / det, (c1[0] * b2 - c2[0] * b1) / det)
-    lam = {}
-    for r, link, q in ((ext1, l1, q1), (ext2, l2, q2)):
-        carried = inner.constraint_load(link, lam_inner)
-        lam[r] = r.multipliers(link, tuple(-a - b for a, b in zip(q, carried)))
-    lam[inner] = lam_inner
-    transmitted = {}
-    for r in (ext1, ext2):
-        known = r.links[0] if r.links[1] in group.links else r.links[1]
-        load = r.constraint_load(known, lam[r])
-        old = transmitted.get(known)
-        transmitted[known] = load if old is None else tuple(a + b for a, b in zip(old, load))
+    """:meth:`assur.dyad.Dyad.reactions` on symbols (its elimination ``_transposed`` run as it
+    is): the multipliers of the group's pairs and the loads transmitted to its known links, NaN
+    where the group's system is singular or the position not valid."""
+    ok, lam, transmitted = group._transposed(frames, {k: applied[k] for k in group.links}, valid)
     bad = ~ok
-    multipliers = {r.joint.name: tuple(np.where(bad, np.nan, v) for v in lam[r]) for r in (ext1, inner, ext2)}
+    multipliers = {name: tuple(np.where(bad, np.nan, v) for v in values) for name, values in lam.items()}
     transmitted = {k: tuple(np.where(bad, np.nan, v) for v in load) for k, load in transmitted.items()}
     return multipliers, transmitted
 
