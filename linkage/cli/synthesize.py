@@ -42,7 +42,7 @@ def add(sub) -> None:
                     "chains.csv, a picture per mechanism (PNG: its graph and, with a geometry, its drawing) and a "
                     "scheme per mechanism that runs (loadable by 'linkage analyze', 'linkage enumerate').")
     p.add_argument("--links", "-n", metavar="N", type=whole(4, 12), required=True,
-                   help="number of links: 4, 6, 8, 10 or 12 (12: 6856 chains, slow)")
+                   help="number of links: 4, 6, 8, 10 or 12 (12: 195816 mechanisms, about 7 minutes)")
     p.add_argument("--dof", metavar="W", type=int, default=1, help="degrees of freedom (only 1 is synthesized)")
     p.add_argument("--out", "-o", metavar="DIR", default=None,
                    help="write the tables, pictures and schemes into DIR (created)")
