@@ -36,7 +36,9 @@ conditioning *at its own scale* (a sine per kind, see its docstring).
    count x L_g).
 3. Positions equal the oracle's (same branch as drawn) to a round-off budget propagated along
    the chain: ``1e3 eps (L_g + |r|) / c_g`` per group plus the upstream budget / c_g (L_g the
-   group's joint spacing, c_g its conditioning); status -1 only where the oracle's conditioning
+   group's joint spacing, c_g its conditioning; the upstream budget of a known link at the
+   group's distance from it, as a guide carries its slider anywhere along it); status -1 only
+   where the oracle's conditioning
    is below ``MIN_MARGIN``, status 0 only where the oracle assembles.
 4. First and second analogs of every named point (``Motion.point_analogs``), link angle and
    slide (``Motion.quantity``) equal central finite differences of positions from
@@ -305,18 +307,33 @@ def position_budget(chain, oracle_poses, margins) -> dict:
     budget = {0: np.full(n, 1e3 * EPS * (chain.crank + np.abs(chain.links["1"].points["O"]).max()))}
     for d in chain.dyads:
         reach = np.max([C.norm(oracle_poses[k][:, :2]) for k in d.links], axis=0) + d.scale
-        upstream = np.max([link_budget(chain, budget, k) for k in d.known], axis=0)
+        # a known link's error reaches the group where its pairs act on that link: for a guide,
+        # wherever along it the slider is, so the lever is the group's distance from the link
+        upstream = np.max([link_budget(chain, budget, k, lever_arm(chain, oracle_poses, d, k)) for k in d.known],
+                          axis=0)
         m = np.maximum(margins[d.index], 1e-300)
         budget[d.index] = (1e3 * EPS * reach + upstream) / m
     return budget
 
 
-def link_budget(chain, budget, link) -> np.ndarray:
-    """Round-off budget ``(N,)`` of any point of ``link`` (m)."""
+def link_budget(chain, budget, link, lever: np.ndarray | float = 0.0) -> np.ndarray:
+    """Round-off budget ``(N,)`` of any point of ``link`` (m) within ``lever`` (m, ``(N,)``) of
+    its origin, or within its own points where that is farther: its group's joint budget plus
+    its angle's (that budget over the group's joint spacing) times the distance."""
     g = chain.group_of_link(link)
     if link == "0":
         return np.zeros_like(budget[0])
-    return budget[g] * (1.0 + C.extent(chain.links[link]) / chain.group_scale(g))
+    return budget[g] * (1.0 + np.maximum(C.extent(chain.links[link]), lever) / chain.group_scale(g))
+
+
+def lever_arm(chain, oracle_poses, dyad, link) -> np.ndarray | float:
+    """``(N,)`` m: where the known ``link`` guides a slider of ``dyad`` (a prismatic pair with its
+    guide on it), how far from the link's origin the dyad acts on it (its links' origins, plus its
+    joint spacing), from the oracle's poses; else 0 (a pin of the link: within its own points)."""
+    if not any(p.kind == "P" and p.a == link for p in (dyad.ext1, dyad.ext2)):
+        return 0.0
+    return np.max([C.norm(oracle_poses[k][:, :2] - oracle_poses[link][:, :2]) for k in dyad.links],
+                  axis=0) + dyad.scale
 
 
 def position_errors(chain, motion, oracle_poses, margins, ok) -> dict:
