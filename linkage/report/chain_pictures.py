@@ -50,6 +50,8 @@ LINK_MARKERS = {
 _LARGE_LINK = ("o", 12.0, "#6b4f2a", "more pairs")
 FRAME_COLOUR = "#222222"
 CRANK_COLOUR = "#d35400"
+#: colour of the pair names written on the lines
+PAIR_COLOUR = "#1a5276"
 
 
 def _graph_of(chain) -> nx.Graph:
@@ -232,7 +234,7 @@ def _title(chain, index: int | None) -> str:
 
 
 def draw_chain(chain, ax=None, *, frame=None, crank=None, title: str | None = None, numbers: bool = False,
-               positions: dict | None = None):
+               positions: dict | None = None, pairs: dict | None = None):
     """Draw a chain's graph: links as nodes (shape by number of pairs), pairs as lines.
 
     Parameters
@@ -249,6 +251,9 @@ def draw_chain(chain, ax=None, *, frame=None, crank=None, title: str | None = No
         Write each link's number beside it.
     positions : dict, optional
         ``{link: (x, y)}``; :func:`chain_layout` by default.
+    pairs : dict, optional
+        ``{(link, link): name}``: each pair's name written at the middle of its line (a
+        mechanism's pair letters, as its drawing writes them).
 
     Returns
     -------
@@ -277,6 +282,10 @@ def draw_chain(chain, ax=None, *, frame=None, crank=None, title: str | None = No
     for a, b in graph.edges():
         (xa, ya), (xb, yb) = positions[a], positions[b]
         ax.plot([xa, xb], [ya, yb], color="#555555", lw=1.4, zorder=1, solid_capstyle="round")
+        name = None if pairs is None else pairs.get((a, b), pairs.get((b, a)))
+        if name is not None:
+            ax.text((xa + xb) / 2, (ya + yb) / 2, str(name), fontsize=SMALL - 1, color=PAIR_COLOUR, ha="center",
+                    va="center", zorder=5, bbox={"boxstyle": "round,pad=0.12", "fc": "white", "ec": "none"})
     for node in graph:
         x, y = positions[node]
         marker, points_size, face, _ = _marker(graph.degree(node))

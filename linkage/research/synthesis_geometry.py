@@ -427,7 +427,7 @@ def _csv(columns: dict[str, list]) -> str:
 
 def picture(chain: Chain, topology: Topology, scheme: str | None, path: str | Path) -> Path:
     """``path`` (PNG): the mechanism's graph (:func:`~linkage.report.chain_pictures.draw_chain`: its
-    frame and crank marked, the links numbered by the mechanism's names) and, with a ``scheme`` text, the mechanism drawn at its first position (needs matplotlib)."""
+    frame and crank marked, the links numbered and the pairs lettered by the mechanism's names) and, with a ``scheme`` text, the mechanism drawn at its first position (needs matplotlib)."""
     plt = pyplot()
     panels = 2 if scheme is not None else 1
     fig = plt.figure(figsize=(4.2 * panels, 4.4))
@@ -437,6 +437,7 @@ def picture(chain: Chain, topology: Topology, scheme: str | None, path: str | Pa
         layout = chain_layout(chain)
         draw_chain(nx.relabel_nodes(chain.graph, names), ax=ax, frame=0, crank=1, numbers=True,
                    positions={names[k]: xy for k, xy in layout.items()},
+                   pairs={(int(a), int(b)): pair for pair, a, b in topology.pairs},
                    title=f"{topology.id}\n{topology.formula}")
         if scheme is not None:
             mech = loads(scheme, source=f"{topology.id}.toml")
