@@ -21,6 +21,7 @@ STAGES = {
     "assur": 0,
     "linkage.errors": 1,
     "linkage.version": 1,
+    "linkage.workers": 2,
     "linkage.model": 2,
     "linkage.structure": 3,
     "linkage.kinematics": 4,

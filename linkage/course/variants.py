@@ -39,6 +39,7 @@ from ..model.scheme import SECTION_PARSERS, loads, toml_text
 from ..report.results import dynamics_results, forces_results, kinematics_results
 from ..report.tables import format_columns
 from ..report.words import unit_for_people
+from ..workers import run_all
 from .overview import overview_pdf
 from .given import given_data, given_json
 from .grading import answers_template
@@ -359,35 +360,6 @@ def _free_text(free: Mapping[str, Any]) -> str:
     return ", ".join(f"{k} = {_value_text(v)}" for k, v in free.items())
 
 
-def _run_serial(template, variants):
-    for v in variants:
-        yield v, build_variant(template, v)
-
-
-def _run_processes(template, variants, workers: int):
-    from concurrent.futures import ProcessPoolExecutor
-
-    with ProcessPoolExecutor(max_workers=workers) as pool:
-        futures = [pool.submit(build_variant, template, v) for v in variants]
-        for v, future in zip(variants, futures, strict=True):
-            yield v, future.result()
-
-
-def _run_dask(template, variants, scheduler: str):
-    try:
-        from distributed import Client
-    except ImportError:
-        raise InputError("--scheduler needs Dask's distributed scheduler: pip install 'linkage[dask]'") from None
-    try:
-        client = Client(scheduler, timeout="10s")
-    except (OSError, TimeoutError) as exc:
-        raise InputError(f"--scheduler {scheduler}: cannot reach a Dask scheduler there ({exc})") from None
-    with client:
-        futures = [client.submit(build_variant, template, v, pure=False) for v in variants]
-        for v, future in zip(variants, futures, strict=True):
-            yield v, future.result()
-
-
 def write_variants(selection: Selection, out: str | Path, *, workers: int = 1, scheduler: str | None = None,
                    progress: Callable[[Iterable, int], Iterable] | None = None) -> list[Path]:
     """Build every selected variant and write the folders and the index into ``out``.
@@ -419,12 +391,8 @@ def write_variants(selection: Selection, out: str | Path, *, workers: int = 1, s
         raise InputError(f"workers must be a whole number >= 1, got {workers!r}")
     variants = list(selection.variants)
     template, seed = selection.template, selection.seed
-    if scheduler is not None:
-        built = _run_dask(template, variants, scheduler)
-    elif workers > 1 and len(variants) > 1:
-        built = _run_processes(template, variants, workers)
-    else:
-        built = _run_serial(template, variants)
+    built = zip(variants, run_all(build_variant, [(template, v) for v in variants], workers=workers,
+                                  scheduler=scheduler), strict=True)
     if progress is not None:
         built = progress(built, len(variants))
     out.mkdir(parents=True, exist_ok=True)

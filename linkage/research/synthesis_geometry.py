@@ -24,7 +24,7 @@ import io
 import itertools
 import math
 import warnings
-from collections.abc import Callable, Iterable, Iterator, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -42,7 +42,8 @@ from ..model.scheme import dumps, loads
 from ..report.chain_pictures import chain_layout, draw_chain
 from ..report.drawing import draw_mechanism
 from ..report.style import pyplot
-from ..structure import MAX_GROUP_LINKS, structure_of
+from ..structure import structure_of
+from ..workers import run_all
 from .assignments import Assignment, PairKind, Reference
 from .chains import Chain
 from .geometry import one_line
@@ -184,9 +185,7 @@ def _all_revolute(topology: Topology) -> Assignment:
 
 def _scheme_text(topology: Topology, mech: Mechanism, seed: int, draw: int, factor: float) -> str:
     """The scheme file: comments saying where it comes from, then the scheme."""
-    header = [f"# {topology.id}: chain {topology.chain}"
-              + (f" ({topology.chain_label})" if topology.chain_label else "")
-              + f", frame link {topology.frame}, crank link {topology.crank}; {topology.formula}",
+    header = [f"# {topology.id}: {_description(topology)}",
               (f"# written by `linkage synthesize --links {topology.links} --with-geometry --seed {seed}`: draw "
                f"{draw}, crank {factor:g} of the drawn one (docs/synthesis.md)")]
     return "\n".join(header) + "\n" + dumps(mech)
@@ -267,11 +266,6 @@ def search_geometry(topology: Topology, seed: int = 0, *, draws: int = DEFAULT_D
     -------
     Found
     """
-    largest = max(len(g.links) for g in topology.groups)
-    if largest > MAX_GROUP_LINKS:
-        return Found(topology.id, False, 0, None, None, None, None,
-                     f"not searched: a group of {largest} links, and the decomposition of a scheme "
-                     f"(linkage.structure.decompose) searches groups of up to {MAX_GROUP_LINKS} links")
     rng = _rng(seed, topology.id)
     first_reason = None
     with warnings.catch_warnings(), np.errstate(all="ignore"):
@@ -316,40 +310,16 @@ def search_all(topologies: Sequence[Topology], seed: int = 0, *, draws: int = DE
         raise InputError(f"draws must be a whole number >= 1, got {draws!r}")
     if not (0.0 < float(min_transmission_angle_deg) < 90.0):
         raise InputError(f"the minimum transmission angle must be in (0, 90) deg, got {min_transmission_angle_deg!r}")
-    options = {"draws": draws, "min_transmission_angle_deg": float(min_transmission_angle_deg)}
-    if scheduler is not None:
-        stream = _run_dask(topologies, seed, options, scheduler)
-    elif workers > 1 and len(topologies) > 1:
-        stream = _run_processes(topologies, seed, options, workers)
-    else:
-        stream = (search_geometry(t, seed, **options) for t in topologies)
+    calls = [(t, seed, draws, float(min_transmission_angle_deg)) for t in topologies]
+    stream = run_all(_search, calls, workers=workers, scheduler=scheduler)
     if progress is not None:
         stream = progress(stream, len(topologies))
     return list(stream)
 
 
-def _run_processes(topologies: Sequence[Topology], seed: int, options: dict, workers: int) -> Iterator[Found]:
-    from concurrent.futures import ProcessPoolExecutor
-
-    with ProcessPoolExecutor(max_workers=workers) as pool:
-        futures = [pool.submit(search_geometry, t, seed, **options) for t in topologies]
-        for future in futures:
-            yield future.result()
-
-
-def _run_dask(topologies: Sequence[Topology], seed: int, options: dict, scheduler: str) -> Iterator[Found]:
-    try:
-        from distributed import Client
-    except ImportError:
-        raise InputError("--scheduler needs Dask's distributed scheduler: pip install 'linkage[dask]'") from None
-    try:
-        client = Client(scheduler, timeout="10s")
-    except (OSError, TimeoutError) as exc:
-        raise InputError(f"--scheduler {scheduler}: cannot reach a Dask scheduler there ({exc})") from None
-    with client:
-        futures = [client.submit(search_geometry, t, seed, pure=False, **options) for t in topologies]
-        for future in futures:
-            yield future.result()
+def _search(topology: Topology, seed: int, draws: int, min_transmission_angle_deg: float) -> Found:
+    """:func:`search_geometry` with its options by position (for :func:`linkage.workers.run_all`)."""
+    return search_geometry(topology, seed, draws=draws, min_transmission_angle_deg=min_transmission_angle_deg)
 
 
 # ----------------------------------------------------------------------------------------------
