@@ -132,7 +132,7 @@ def error_bound(ratio: np.ndarray, input_error, factor: float = ROUNDOFF_FACTOR)
     kind's round-off factor (:attr:`Group.roundoff_factor`)."""
     with np.errstate(divide="ignore", invalid="ignore"):
         own = np.where(ratio > 0, factor * np.finfo(float).eps / ratio**2, np.inf)
-        return own + np.where(np.asarray(input_error) > 0, input_error / ratio, 0.0)
+        return own + np.where(np.greater(input_error, 0), input_error / ratio, 0.0)
 
 
 def analog_size(analogs, scale) -> np.ndarray:
@@ -160,23 +160,23 @@ def second_analog_excess(ratio: np.ndarray, input_error, rotation, first_size, s
     stay bounded while ``r`` goes to 0, and the term takes over (docs/numerics.md)."""
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         amplitude = rotation * np.where(second_size > first_size, first_size / second_size, 1.0)
-        first = CHANGE_FACTOR * np.finfo(float).eps / ratio**2 + np.asarray(input_error, float) / ratio
+        first = CHANGE_FACTOR * np.finfo(float).eps / ratio**2 + input_error / ratio
         return np.where(ratio > 0, 2.0 * amplitude * first / ratio, np.inf)
 
 
-def flag_second_analogs(group: "Group", status, bound, ratio, input_error, scale, first, second, solved):
+def second_analog_status(group: "Group", status, bound, ratio, input_error, scale, first, second):
     """Statuses and bounds ``(N,)`` of a group once its second analogs are solved.
 
     At status-OK positions the bound grows by a tenth of :func:`second_analog_excess` (the
     second analogs are promised ten times ``ANALOG_TOL``); a position whose bound then exceeds
     ``ANALOG_TOL`` becomes ``SINGULAR``. ``scale``: the group's size ``(N,)``, m; ``first``,
     ``second``: analogs of every link involved, link -> three columns ``(vx, vy, w)`` of
-    ``(N,)`` (or an ``(N, 3)`` array transposed); ``solved``: the group's analog dicts of
-    ``(N, 3)`` arrays, set to NaN in place where a position is flagged.
+    ``(N,)`` (or an ``(N, 3)`` array transposed). Array operations only (the compiled kernel,
+    :mod:`linkage.kinematics.kernel`, traces it as it is).
     """
     guides = {j.a for j in group.joints if j.kind == "P"}
     rotation = 0.0
-    for link in {*group.links, *(guides & set(group.known_links))}:
+    for link in sorted({*group.links, *(guides & set(group.known_links))}):
         rotation = np.maximum(rotation, np.abs(first[link][2]))
     links = (*group.known_links, *group.links)
     excess = second_analog_excess(ratio, input_error, rotation, analog_size([first[k] for k in links], scale),
@@ -184,11 +184,18 @@ def flag_second_analogs(group: "Group", status, bound, ratio, input_error, scale
     ok = status == OK
     with np.errstate(invalid="ignore"):
         bound = np.where(ok, bound + excess / 10.0, bound)
-    flagged = ok & ~(bound <= ANALOG_TOL)
+    return np.where(ok & ~(bound <= ANALOG_TOL), SINGULAR, status), bound
+
+
+def flag_second_analogs(group: "Group", status, bound, ratio, input_error, scale, first, second, solved):
+    """:func:`second_analog_status`, and the group's analog dicts of ``(N, 3)`` arrays ``solved``
+    set to NaN in place where a position is flagged."""
+    flagged_status, bound = second_analog_status(group, status, bound, ratio, input_error, scale, first, second)
+    flagged = flagged_status != status
     for values in solved:
         for v in values.values():
             v[flagged] = np.nan
-    return np.where(flagged, SINGULAR, status), bound
+    return flagged_status, bound
 
 
 def global_point(pose: np.ndarray, local) -> np.ndarray:

@@ -10,10 +10,9 @@ mechanism, order and assembly branches.
 
 How it is written: the general path's own code (each kind's ``_place``, the pair rows of
 :mod:`assur.rows`, ``Dyad._conditioning`` and ``Dyad._eliminate``) is run once on symbolic
-arrays (:class:`_Sym`) that record every numpy operation in a graph; the steps of
-:meth:`Dyad.solve`, :func:`assur.base.error_bound`, :func:`assur.base.flag_second_analogs` and
-of ``run_blocks`` / :func:`linkage.kinematics.inputs.input_state` are restated here on the same
-symbols. The graph keeps the general path's operations in their order (so the numbers are the
+arrays (:class:`_Sym`) that record every numpy operation in a graph, with the error bounds and
+second-analog statuses of :mod:`assur.base`; the steps of :meth:`Dyad.solve` and of ``run_blocks``
+/ :func:`linkage.kinematics.inputs.input_state` are restated here on the same symbols. The graph keeps the general path's operations in their order (so the numbers are the
 same, bit for bit where numpy evaluates them alike), with what does not depend on the input
 angle folded to constants, identical subexpressions merged, dead ones dropped and the
 temporaries' buffers reused (``out=``) once their last use is passed.
@@ -37,8 +36,8 @@ from typing import Any
 
 import numpy as np
 
-from assur.base import (ANALOG_TOL, CANNOT_ASSEMBLE, CHANGE_FACTOR, CLOSURE_TOL, OK, SINGULAR, DrivenPrismaticJoint,
-                        rotate)
+from assur.base import (ANALOG_TOL, CANNOT_ASSEMBLE, CLOSURE_TOL, OK, SINGULAR, DrivenPrismaticJoint, error_bound,
+                        rotate, second_analog_status)
 from assur.dyad import Dyad
 from assur.rows import rows_of, xy
 
@@ -449,7 +448,7 @@ def _solve_dyad(group, frames, first, second, branch, input_error, order) -> dic
     c1, c2 = inner.act(l1, ext1.null(l1)), inner.act(l2, ext2.null(l2))
     det = c1[0] * c2[1] - c1[1] * c2[0]
     ratio, scale = group._conditioning(rows, frames, det)
-    bound = np.where(assembled, _error_bound(ratio, input_error, group.roundoff_factor), np.inf)
+    bound = np.where(assembled, error_bound(ratio, input_error, group.roundoff_factor), np.inf)
     status = np.where(assembled, np.where(bound <= ANALOG_TOL, OK, SINGULAR), CANNOT_ASSEMBLE)
     sign = np.where(assembled, np.sign(det), 0.0)
     conditioning = np.where(assembled, ratio, np.nan)
@@ -466,45 +465,13 @@ def _solve_dyad(group, frames, first, second, branch, input_error, order) -> dic
             gammas = [r.quadratic(solved1) for r in rows]
             known2 = {k: second[k] for k in group.known_links}
             a1, a2 = group._eliminate(rows, system, known2, gammas)
-            status, bound = _flag_second(group, status, bound, ratio, input_error, scale, solved1,
-                                         {**known2, l1: a1, l2: a2})
+            status, bound = second_analog_status(group, status, bound, ratio, input_error, scale, solved1,
+                                                 {**known2, l1: a1, l2: a2})
             bad = status != OK      # the solve's NaN where not OK, then where flagged: the same
             second[l1], second[l2] = (tuple(np.where(bad, np.nan, v) for v in a) for a in (a1, a2))
         first[l1], first[l2] = (tuple(np.where(bad, np.nan, v) for v in q) for q in (q1, q2))
     return {"poses": poses, "status": status, "sign": sign, "conditioning": conditioning, "bound": bound,
             "scale": np.where(assembled, scale, np.nan)}
-
-
-def _error_bound(ratio, input_error, factor):
-    """:func:`assur.base.error_bound` on symbols."""
-    own = np.where(ratio > 0, factor * EPS / ratio**2, np.inf)
-    return own + np.where(input_error > 0, input_error / ratio, 0.0)
-
-
-def _flag_second(group, status, bound, ratio, input_error, scale, first, second):
-    """:func:`assur.base.flag_second_analogs` on symbols (without the NaN writes, done by the caller)."""
-    guides = {j.a for j in group.joints if j.kind == "P"}
-    rotation = 0.0
-    for link in sorted({*group.links, *(guides & set(group.known_links))}):
-        rotation = np.maximum(rotation, np.abs(first[link][2]))
-    links = (*group.known_links, *group.links)
-    first_size, second_size = (_analog_size([d[k] for k in links], scale) for d in (first, second))
-    amplitude = rotation * np.where(second_size > first_size, first_size / second_size, 1.0)
-    own = CHANGE_FACTOR * EPS / ratio**2 + input_error / ratio
-    excess = np.where(ratio > 0, 2.0 * amplitude * own / ratio, np.inf)
-    ok = status == OK
-    bound = np.where(ok, bound + excess / 10.0, bound)
-    flagged = ok & ~(bound <= ANALOG_TOL)
-    return np.where(flagged, SINGULAR, status), bound
-
-
-def _analog_size(analogs, scale):
-    """:func:`assur.base.analog_size` on symbols."""
-    turn = move = 0.0
-    for vx, vy, w in analogs:
-        turn = np.maximum(turn, np.abs(w))
-        move = np.maximum(move, vx * vx + vy * vy)
-    return np.maximum(turn, np.sqrt(move) / scale)
 
 
 # ----------------------------------------------------------------------------------------------

@@ -317,17 +317,17 @@ def reactions_under(motion: Motion, terms: list[LoadTerm], pairs: Iterable[str] 
     everything = _links_loaded(motion, pairs) is None
     group_ids = range(len(structure.groups)) if pairs is None else structure.loading_groups(set(pairs))
     applied = generalized_loads(motion, terms)
-    multipliers: dict[str, np.ndarray] = {}
     valid = motion.status == OK
-    n = len(motion.phi)
     heading = _sense(motion, sense)
     static = 1.0 if sense is None else float(sense)
-    locked_pair = np.full(n, "", dtype=object)
-    lost: list[LoadTerm] = []
     compiled = run_reactions_kernel(motion, applied, valid) if everything and not friction else None
     if compiled is not None:     # the same steps as below, compiled (kinetostatics/kernel.py)
         multipliers, balancing = compiled
         return Reactions(motion, multipliers, balancing[structure.inputs[0]], terms, notes, balancing, sense=static)
+    multipliers: dict[str, np.ndarray] = {}
+    n = len(motion.phi)
+    locked_pair = np.full(n, "", dtype=object)
+    lost: list[LoadTerm] = []
     for i in reversed(group_ids):
         group = structure.groups[i]
         frames = {k: motion.frame(k) for k in (*group.links, *group.known_links)}
