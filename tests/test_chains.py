@@ -29,7 +29,7 @@ from linkage.research.chains import (
     rigid_subchain,
 )
 
-pytest.importorskip("igraph")
+pytest.importorskip("igraph", reason="the chains need the synthesis extra (igraph): pip install \".[synthesis]\"")
 
 #: links -> chains, from the literature
 COUNTS = {4: 1, 6: 2, 8: 16, 10: 230}
@@ -234,7 +234,7 @@ def test_eight_link_layouts_have_no_crossing_and_no_overlap():
 
 
 def test_grid_picture_names_every_chain(tmp_path):
-    matplotlib = pytest.importorskip("matplotlib")
+    matplotlib = pytest.importorskip("matplotlib", reason="pictures need the plot extra (matplotlib)")
     matplotlib.use("Agg")
     from linkage.report.chain_pictures import draw_chain, draw_chains
 

@@ -30,7 +30,7 @@ from linkage.research.synthesis_geometry import (
 )
 from linkage.structure import MAX_GROUP_LINKS, decompose
 
-pytest.importorskip("igraph")
+pytest.importorskip("igraph", reason="structural synthesis needs the synthesis extra (igraph): pip install \".[synthesis]\"")
 
 
 def _choices_by_brute_force(chain) -> tuple[int, int]:
