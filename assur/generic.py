@@ -21,7 +21,8 @@ import numpy as np
 from .base import CANNOT_ASSEMBLE, NOT_CONVERGED, OK, SINGULAR, Group, GroupPosition, Poses
 from .fused import layout_of
 
-__all__ = ["NewtonGroup", "NEWTON_STEPS", "TRACE_JUMP", "GROUP_ROUNDOFF_FACTOR", "newton", "newton_pairwise",
+__all__ = ["NewtonGroup", "NEWTON_STEPS", "TRACE_JUMP", "GROUP_ROUNDOFF_FACTOR", "newton", "newton_closing",
+           "newton_pairwise",
            "group_class_of"]
 
 #: most Newton steps per solve
@@ -103,47 +104,135 @@ def newton(group: Group, poses: Poses, start: Poses, steps: int | None = None):
     layout = layout_of(group)
     if layout is None:
         return newton_pairwise(group, poses, start, steps)
-    links = group.links
+    stack = _stack(layout, group, poses, start)
+    converged, _ = _iterate(layout, group, stack, NEWTON_STEPS if steps is None else steps)
+    return _split(stack[:, :len(group.links)].reshape(len(stack), -1), group.links), converged
+
+
+def newton_closing(group: Group, poses: Poses, start: Poses, closure: float, steps: int | None = None):
+    """Newton's method as :func:`newton`, each position stopped as soon as it closes to ``closure``.
+
+    What following an assembly mode over a sweep needs (:mod:`linkage.kinematics.tracing`): poses
+    that close to a tolerance, and how well they close, without the iteration that confirms a
+    step below :data:`STEP_TOL` nor a separate evaluation of the residual.
+
+    Parameters
+    ----------
+    poses : dict of link -> ndarray (N, 3) or (1, 3)
+        Poses of the known links.
+    start, steps
+        As :func:`newton`.
+    closure : float
+        m: a position stops once every equation's residual (prismatic angle rows times the
+        group's size) is at most this.
+
+    Returns
+    -------
+    solved : dict of link -> ndarray (N, 3)
+        The poses reached.
+    gap : ndarray (N,)
+        m: the largest residual at ``solved`` (inf where a pose is not finite).
+    """
     steps = NEWTON_STEPS if steps is None else steps
-    q = np.concatenate([np.asarray(start[k], float) for k in links], axis=1)
-    N, width = q.shape
-    known_links = layout.order[len(links):]
-    known = np.broadcast_to(layout.stack(poses, known_links), (N, len(known_links), 3)) if known_links \
-        else np.zeros((N, 0, 3))
-    converged = np.zeros(N, bool)
+    layout = layout_of(group)
+    if layout is None:
+        N = len(start[group.links[0]])
+        poses = {k: np.broadcast_to(v, (N, 3)) for k, v in poses.items()}
+        solved, _ = newton_pairwise(group, poses, start, steps)
+        gap = np.max(np.abs(group.residual({**poses, **solved})), axis=1)
+        return solved, np.nan_to_num(gap, nan=np.inf)
+    stack = _stack(layout, group, poses, start)
+    _, gap = _iterate(layout, group, stack, steps, closure)
+    return _split(stack[:, :len(group.links)].reshape(len(stack), -1), group.links), gap
+
+
+def _stack(layout, group: Group, poses: Poses, start: Poses) -> np.ndarray:
+    """The pose stack ``(N, L + K, 3)`` of :meth:`assur.fused.FusedLayout.evaluate`: the start
+    poses of the group's links, then the known links' poses (broadcast to N)."""
+    links = group.links
+    first = np.asarray(start[links[0]], float)
+    N = len(first)
+    stack = np.empty((N, len(layout.order), 3))
+    for i, k in enumerate(layout.order):
+        stack[:, i] = start[k] if i < len(links) else poses[k]
+    return stack
+
+
+def _iterate(layout, group: Group, stack: np.ndarray, steps: int, closure: float | None = None):
+    """Newton's iterations on the pose stack ``stack`` (its group links' poses updated in place).
+
+    Without ``closure`` a position stops when its step is below :data:`STEP_TOL` (converged),
+    its system is singular or its poses leave the finite numbers: returns ``(converged, None)``.
+    With ``closure`` (m) a position stops as soon as its residual is at most ``closure``:
+    returns ``(None, gap)``, the largest residual at the poses left (inf where not finite).
+    Steps are damped as in :func:`newton_pairwise`.
+    """
+    N, L = len(stack), len(group.links)
+    width = 3 * L
+    q = stack[:, :L].reshape(N, width)          # a view: the stack's rows of the group's links
     limit, unit, positive = layout.damping(group.size, N)
+    converged = np.zeros(N, bool)
+    gap = np.full(N, np.inf) if closure is not None else None
+    weight = None
+    if closure is not None and len(layout.angle_rows):
+        weight = np.ones((1, layout.rows)) if np.ndim(group.size) == 0 else np.ones((N, layout.rows))
+        weight[:, layout.angle_rows] = np.reshape(group.size, (-1, 1))
     rows = np.flatnonzero(np.isfinite(q).all(axis=1))       # the positions still iterated
     for _ in range(steps if len(rows) else 0):
         every = len(rows) == N
-        at = slice(None) if every else rows
-        here = q if every else q[rows]
-        residual, full = layout.evaluate(np.concatenate([here.reshape(len(rows), -1, 3), known[at]], axis=1))
+        residual, full = layout.evaluate(stack if every else stack[rows])
+        if closure is not None:
+            norm = np.abs(residual if weight is None else residual * (weight if len(weight) == 1 else weight[rows])
+                          ).max(axis=1)
+            close = norm <= closure
+            if close.any():
+                gap[rows[close]] = norm[close]
+                keep = ~close
+                rows, residual, full, norm = rows[keep], residual[keep], full[keep], norm[keep]
+                if not len(rows):
+                    break
+                every = False
         step, solvable = _solve_regular(full[:, :, :width], -residual)
-        scale = limit if limit.ndim == 1 else limit[at]
+        scale = limit if limit.ndim == 1 else limit[rows]
         if solvable is True and positive:
             # every system solved, every step finite: the damping of newton_pairwise in fewer calls
             factor = (scale / np.maximum(np.abs(step), scale)).min(axis=1)
             step *= factor[:, None]
-            here += step
-            done = ((np.abs(step) / (unit if unit.ndim == 1 else unit[at])).max(axis=1) <= STEP_TOL) & (factor == 1.0)
-            stop = done if np.isfinite(here).all() else done | ~np.isfinite(here).all(axis=1)
         else:
             solvable = np.ones(len(rows), bool) if solvable is True else solvable
             with np.errstate(invalid="ignore", divide="ignore"):
                 factor = np.min(np.where(np.abs(step) > scale, scale / np.abs(step), 1.0), axis=1)
             step *= factor[:, None]
-            here += np.where(solvable[:, None], step, 0.0)
-            small = np.max(np.abs(step) / (unit if unit.ndim == 1 else unit[at]), axis=1) <= STEP_TOL
-            done = solvable & small & (factor == 1.0)
-            stop = done | ~solvable | ~np.all(np.isfinite(here), axis=1)
-        if not every:
+            step[~solvable] = 0.0
+        if every:
+            q += step
+            here = q
+        else:
+            here = q[rows] + step
             q[rows] = here
-        if stop.any():
+        lost = None if np.isfinite(here).all() else ~np.isfinite(here).all(axis=1)     # positions that stop
+        if solvable is not True:
+            lost = ~solvable if lost is None else lost | ~solvable
+            if closure is not None:
+                gap[rows[~solvable]] = np.nan_to_num(norm[~solvable], nan=np.inf)
+        if closure is None:
+            done = ((np.abs(step) / (unit if unit.ndim == 1 else unit[rows])).max(axis=1) <= STEP_TOL) & (factor == 1.0)
+            if solvable is not True:
+                done &= solvable
             converged[rows[done]] = True
-            rows = rows[~stop]
+            lost = done if lost is None else done | lost
+        if lost is not None and lost.any():
+            rows = rows[~lost]
             if not len(rows):
                 break
-    return _split(q, links), converged
+    else:
+        if closure is not None and len(rows):           # out of steps: how well the last poses close
+            residual, _ = layout.evaluate(stack[rows], jacobian=False)
+            if weight is not None:
+                residual = residual * (weight if len(weight) == 1 else weight[rows])
+            with np.errstate(invalid="ignore"):
+                gap[rows] = np.nan_to_num(np.abs(residual).max(axis=1), nan=np.inf)
+    return converged, gap
 
 
 def newton_pairwise(group: Group, poses: Poses, start: Poses, steps: int | None = None):

@@ -21,7 +21,8 @@ import assur.fused  # noqa: E402
 import linkage  # noqa: E402
 from assur.base import Group  # noqa: E402
 from assur.fused import layout_of  # noqa: E402
-from assur.generic import NewtonGroup, newton, newton_pairwise  # noqa: E402
+from assur.generic import NewtonGroup, newton, newton_closing, newton_pairwise  # noqa: E402
+from linkage.kinematics import tracing  # noqa: E402
 from linkage.structure import structure_of  # noqa: E402
 
 TIGHT = 1e-13
@@ -133,6 +134,55 @@ def test_fused_newton_reaches_what_the_pairwise_newton_reaches(label, group):
     np.testing.assert_array_equal(ok, ok_pairwise)
     for k in group.links:
         np.testing.assert_allclose(again[k], again_pairwise[k], rtol=TIGHT, atol=TIGHT * size)
+
+
+@pytest.mark.parametrize("fused", [True, False], ids=["fused", "pairwise"])
+@pytest.mark.parametrize("label, group", DRAWN, ids=[label for label, _ in DRAWN])
+def test_newton_closing_stops_where_the_group_closes_and_reports_how_well(label, group, fused, monkeypatch):
+    """newton_closing's gap is the largest residual of the pair-by-pair equations (prismatic angle
+    rows times the size) at the poses it returns; a position it reports closed is the solution
+    Newton's method converges to from the same start, to the closure over the conditioning."""
+    monkeypatch.setattr(assur.fused, "FUSED", fused)
+    size = float(np.max(group.size))
+    poses = _random_poses(group, 64, 6)
+    known = {k: poses[k] * np.array([0.2, 0.2, 0.1]) for k in group.known_links}
+    start = {k: poses[k] for k in group.links}
+    closure = 1e-12 * size
+    solved, gap = newton_closing(group, known, start, closure)
+    converged_at, converged = newton(group, known, start)
+    residual = np.abs(Group.residual(group, {**known, **solved})).max(axis=1)
+    finite = np.isfinite(residual)
+    np.testing.assert_allclose(gap[finite], residual[finite], rtol=1e-12, atol=1e-15 * size)
+    assert np.all(np.isinf(gap[~finite]))
+    closed = gap <= closure
+    assert closed.sum() >= converged.sum() > 0
+    both = closed & converged
+    for k in group.links:
+        np.testing.assert_allclose(solved[k][both], converged_at[k][both], rtol=0, atol=1e-7 * size)
+    # known poses given once, (1, 3), for every position: the same result
+    once = {k: v[:1] for k, v in known.items()}
+    repeated = {k: np.repeat(v, 64, axis=0) for k, v in once.items()}
+    a, gap_a = newton_closing(group, once, start, closure)
+    b, gap_b = newton_closing(group, repeated, start, closure)
+    np.testing.assert_array_equal(gap_a, gap_b)
+
+
+@pytest.mark.parametrize("label, group", DRAWN[-2:], ids=[label for label, _ in DRAWN[-2:]])
+def test_random_starts_at_several_positions_in_one_call_find_each_positions_modes(label, group):
+    """The modes found from random starts at four positions at once are those found position by
+    position, in the same order (the batch changes nothing a position sees)."""
+    size = float(np.max(group.size))
+    poses = _random_poses(group, 4, 8)
+    known = {k: poses[k] * np.array([0.2, 0.2, 0.1]) for k in group.known_links}
+    solved, good = tracing._random_starts(group, known, size)
+    found_somewhere = 0
+    for s in range(4):
+        alone = tracing.random_start_modes(group, {k: v[s:s + 1] for k, v in known.items()}, size)
+        batched = tracing._distinct(group, {k: v[s] for k, v in solved.items()}, good[s], size)
+        found_somewhere += len(alone[group.links[0]])
+        for k in group.links:
+            np.testing.assert_array_equal(batched[k], alone[k])
+    assert found_somewhere > 0
 
 
 def test_the_switch_and_per_position_geometry_take_the_pairwise_path(monkeypatch):

@@ -26,7 +26,7 @@ from typing import Callable, NamedTuple
 
 import numpy as np
 
-from assur.generic import TRACE_JUMP, newton
+from assur.generic import TRACE_JUMP, newton, newton_closing
 
 __all__ = ["Trace", "trace_modes", "track_of", "random_start_modes", "poses_distance", "finite_poses", "same_circuit", "STARTS", "SEEDS",
            "REFINEMENTS", "LIMIT_BISECTIONS"]
@@ -47,6 +47,10 @@ LIMIT_BISECTIONS = 10
 LIMIT_STEPS = 12
 #: two poses of a group closer than this fraction of its size are the same assembly mode
 SAME_MODE = 1e-6
+#: a traced step stops Newton's method once the group closes to this fraction of its size (a
+#: step is good where it closes to 1e-9): a trace's poses are starts for the analysis, which
+#: polishes them to its own tolerance
+TRACE_CLOSURE = 1e-12
 #: new traces started at most (each from a mode no earlier trace holds)
 MAX_TRACES = 48
 
@@ -96,9 +100,10 @@ def trace_modes(group, phi: np.ndarray, known: Poses, known_at: Callable[[np.nda
                 break
             traces += walk.both_ways(m, modes)
     else:
-        M = len(phi)
-        for m in np.unique(np.linspace(0, M, SEEDS, endpoint=False).astype(int)):
-            found = random_start_modes(group, {k: v[m:m + 1] for k, v in known.items()}, size)
+        seeds = np.unique(np.linspace(0, len(phi), SEEDS, endpoint=False).astype(int))
+        solved, good = _random_starts(group, {k: v[seeds] for k, v in known.items()}, size)
+        for s, m in enumerate(seeds):
+            found = _distinct(group, {k: v[s] for k, v in solved.items()}, good[s], size)
             fresh = _not_held(found, traces, m, group.links, size)
             if len(fresh) and len(traces) < MAX_TRACES:
                 traces += walk.both_ways(int(m), {k: v[fresh] for k, v in found.items()})
@@ -158,34 +163,53 @@ def random_start_modes(group, at0: Poses, size: float, around: Poses | None = No
     """The distinct assembly modes ``{link: (C, 3)}`` Newton's method reaches from :data:`STARTS`
     random starts at one position, where the known links have the poses ``at0`` ``{link: (1, 3)}``.
 
+    The starts are :func:`_random_starts`'s (seeded: the same inputs give the same modes in the
+    same order), around the poses ``around`` ``{link: (1, 3)}``. A solution counts where Newton's
+    method closes to :data:`TRACE_CLOSURE` of ``size``; it is a new mode when it lies farther
+    than :data:`SAME_MODE` of ``size`` (:func:`poses_distance`) from every mode kept before it and
+    from ``besides`` (a mode ``{link: (3,)}`` already known, not returned).
+    """
+    solved, good = _random_starts(group, at0, size, around)
+    return _distinct(group, {k: v[0] for k, v in solved.items()}, good[0], size, besides)
+
+
+def _random_starts(group, at0: Poses, size: float, around: Poses | None = None) -> tuple[Poses, np.ndarray]:
+    """Newton's method from :data:`STARTS` random starts at each of S positions, where the known
+    links have the poses ``at0`` ``{link: (S, 3)}``, all in one call.
+
     The starts lie within ``size`` (m) in x and y of the centroid of the group's contact points
     with its links at the poses ``around`` ``{link: (1, 3)}`` (default: each at the origin,
-    unturned), each link turned at random; the generator is seeded (0) at every call, so that the
-    same inputs give the same modes in the same order. A solution counts where Newton's method
-    converged and the group closes to 1e-9 of ``size``; it is a new mode when it lies farther than
-    :data:`SAME_MODE` of ``size`` (:func:`poses_distance`) from every mode kept before it and from
-    ``besides`` (a mode ``{link: (3,)}`` already known, not returned).
+    unturned), each link turned at random; the generator is seeded (0) at every call, and every
+    position takes the same draws. Returns the poses reached ``{link: (S, STARTS, 3)}`` and where
+    they close to :data:`TRACE_CLOSURE` of ``size`` ``(S, STARTS)``.
     """
+    S = len(next(iter(at0.values())))
     rng = np.random.default_rng(0)
+    draws = {k: (rng.uniform(-1, 1, STARTS), rng.uniform(-1, 1, STARTS), rng.uniform(-np.pi, np.pi, STARTS))
+             for k in group.links}
+    at = {k: np.zeros((S, 3)) if around is None else np.repeat(around[k], S, axis=0) for k in group.links}
+    centre = np.nanmean(group.contact_points({**at0, **at}), axis=1)                        # (S, 2)
+    guesses = {k: np.stack([centre[:, :1] + size * x, centre[:, 1:] + size * y, np.broadcast_to(turn, (S, STARTS))],
+                           axis=-1).reshape(S * STARTS, 3) for k, (x, y, turn) in draws.items()}
     known = {k: np.repeat(v, STARTS, axis=0) for k, v in at0.items()}
-    at = {k: np.zeros((1, 3)) for k in group.links} if around is None else around
-    anchors = group.contact_points({**at0, **at})
-    centre = np.nanmean(anchors[0], axis=0)
-    guesses = {k: np.column_stack([centre[0] + size * rng.uniform(-1, 1, STARTS),
-                                   centre[1] + size * rng.uniform(-1, 1, STARTS),
-                                   rng.uniform(-np.pi, np.pi, STARTS)]) for k in group.links}
-    solved, converged = newton(group, known, guesses)
-    closure = np.max(np.abs(group.residual({**known, **solved})), axis=1)
-    with np.errstate(invalid="ignore"):
-        good = np.flatnonzero(converged & (closure <= 1e-9 * size))
+    solved, gap = newton_closing(group, known, guesses, TRACE_CLOSURE * size)
+    return {k: v.reshape(S, STARTS, 3) for k, v in solved.items()}, (gap <= TRACE_CLOSURE * size).reshape(S, STARTS)
+
+
+def _distinct(group, solved: Poses, good: np.ndarray, size: float, besides: Poses | None = None) -> Poses:
+    """The solutions ``solved`` ``{link: (n, 3)}`` where ``good`` ``(n,)``, each kept when it lies
+    farther than :data:`SAME_MODE` of ``size`` from every one kept before it and from ``besides``."""
+    rows = np.flatnonzero(good)
+    found = {k: v[rows] for k, v in solved.items()}
+    apart = poses_distance({k: v[:, None] for k, v in found.items()}, {k: v[None] for k, v in found.items()},
+                           group.links, size) > SAME_MODE * size                                  # (G, G)
+    usable = np.ones(len(rows), bool) if besides is None else \
+        poses_distance(found, {k: np.asarray(v)[None] for k, v in besides.items()}, group.links, size) > SAME_MODE * size
     kept: list[int] = []
-    for n in good:
-        candidate = {k: v[n] for k, v in solved.items()}
-        gap = poses_distance(candidate, {k: v[kept] for k, v in solved.items()}, group.links, size)
-        if np.all(gap > SAME_MODE * size) and (besides is None
-                                               or poses_distance(candidate, besides, group.links, size) > SAME_MODE * size):
+    for n in np.flatnonzero(usable):
+        if apart[n, kept].all():
             kept.append(int(n))
-    return {k: v[kept] for k, v in solved.items()}
+    return {k: v[kept] for k, v in found.items()}
 
 
 # ----------------------------------------------------------------------------------------------
@@ -234,7 +258,7 @@ class _Walk:
             indices = [(m + direction * s) % M for s in range(1, M)]
         else:
             indices = list(range(m + 1, M)) if direction > 0 else list(range(m - 1, -1, -1))
-        current, angle, previous = dict(starts), float(phi[m]), None
+        current, angle, history = dict(starts), float(phi[m]), ()
         for index in indices:
             if filled is not None:
                 stop = filled[index]
@@ -244,7 +268,7 @@ class _Walk:
             options = None if listed is None else ({k: v[index:index + 1] for k, v in listed[0].items()},
                                                    listed[1][index:index + 1])
             reached, ok = _advance(group, current, {k: v[index:index + 1] for k, v in known.items()}, options, size,
-                                   previous)
+                                   history)
             retry = np.flatnonzero(~ok & finite_poses(current))
             if len(retry):
                 fixed, good, found = _refine(group, {k: v[retry] for k, v in current.items()}, angle, step,
@@ -253,7 +277,7 @@ class _Walk:
                     reached[k][retry] = fixed[k]
                 ok[retry] = good
                 samples += [(int(retry[j]), at, poses) for j, at, poses in found]
-            previous = current if not len(retry) else None      # a refined step: no even pace to extrapolate
+            history = (current,) + history[:1] if not len(retry) else ()      # a refined step: no even pace
             current = {k: np.where(ok[:, None], v, np.nan) for k, v in reached.items()}
             for k in group.links:
                 rows[k][index] = current[k]
@@ -264,7 +288,7 @@ class _Walk:
         return rows, at, owner, extra
 
 
-def _advance(group, current: Poses, known: Poses, options, size: float, previous: Poses | None = None,
+def _advance(group, current: Poses, known: Poses, options, size: float, history: tuple[Poses, ...] = (),
              steps: int | None = None):
     """One step of every trace: from its poses ``current`` ``{link: (C, 3)}`` to the next angle,
     where the known links have the poses ``known`` ``{link: (1, 3)}`` and the listed modes are
@@ -272,41 +296,51 @@ def _advance(group, current: Poses, known: Poses, options, size: float, previous
     mode nearest to it, else (none listed, or none near: a listing may lose a mode next to a
     position where two modes meet) the point Newton's method reaches from it. Returns the poses
     reached and where the step is good: a position that closes to 1e-9 of the size, within
-    :data:`TRACE_JUMP` of the size of the current one. ``previous``: the poses one equal step
-    before ``current``, when there are: Newton's method then starts from their linear
-    extrapolation (one iteration fewer on a smooth trace). ``steps``: Newton steps at most
-    (default :data:`assur.generic.NEWTON_STEPS`)."""
-    C = len(next(iter(current.values())))
-    reached = {k: np.full((C, 3), np.nan) for k in group.links}
+    :data:`TRACE_JUMP` of the size of the current one. ``history``: the poses one and two equal
+    steps before ``current`` (most recent first), as many as there are: Newton's method then
+    starts from their extrapolation, quadratic or linear (one or two iterations fewer on a smooth
+    trace). ``steps``: Newton steps at most (default :data:`assur.generic.NEWTON_STEPS`)."""
+    links = group.links
+    C = len(current[links[0]])
     if options is not None:
         candidates, valid = options
-        gap2 = sum(_pose_distance(candidates[k][0][None], current[k][:, None], size) ** 2 for k in group.links)
+        gap2 = sum(_squared_gap(candidates[k][0][None], current[k][:, None], size) for k in links)
         gap2 = np.where(valid[0][None], np.nan_to_num(gap2, nan=np.inf), np.inf)            # (C, K)
         best = np.argmin(gap2, axis=1)
-        reached = {k: candidates[k][0][best] for k in group.links}
-    ok = _moved(group, reached, current, size) <= TRACE_JUMP * size
-    rows = np.flatnonzero(~ok & finite_poses(current))
+        reached = {k: candidates[k][0][best] for k in links}
+        ok = poses_distance(reached, current, links, size) <= TRACE_JUMP * size      # False where NaN
+        rows = np.flatnonzero(~ok & finite_poses(current))
+    else:
+        reached, ok = None, np.zeros(C, bool)
+        rows = np.flatnonzero(finite_poses(current))
     if len(rows):
-        here = {k: np.repeat(v, len(rows), axis=0) for k, v in known.items()}
-        start = {k: v[rows] for k, v in current.items()}
-        if previous is not None:
-            ahead = {k: 2 * v[rows] - previous[k][rows] for k, v in current.items()}
-            usable = finite_poses(ahead)
-            start = {k: np.where(usable[:, None], ahead[k], v) for k, v in start.items()}
-        solved, _ = newton(group, here, start, steps)
-        closure = np.max(np.abs(group.residual({**here, **solved})), axis=1)
-        with np.errstate(invalid="ignore"):
-            ok[rows] = (closure <= 1e-9 * size) & (_moved(group, solved, {k: v[rows] for k, v in current.items()},
-                                                          size) <= TRACE_JUMP * size)
-        for k in group.links:
+        start = _extrapolated(current, history) if history else current
+        every = len(rows) == C
+        if not every:
+            start, current = ({k: v[rows] for k, v in start.items()}, {k: v[rows] for k, v in current.items()})
+        solved, gap = newton_closing(group, known, start, TRACE_CLOSURE * size, steps)
+        ok[rows] = (gap <= 1e-9 * size) & (poses_distance(solved, current, links, size) <= TRACE_JUMP * size)
+        if reached is None and every:
+            return solved, ok
+        if reached is None:
+            reached = {k: np.full((C, 3), np.nan) for k in links}
+        for k in links:
             reached[k][rows] = solved[k]
+    elif reached is None:
+        reached = {k: np.full((C, 3), np.nan) for k in links}
     return reached, ok
 
 
-def _moved(group, a: Poses, b: Poses, size: float) -> np.ndarray:
-    """Distance ``(C,)``, m, between poses of the group's links (``inf`` where one is NaN)."""
-    gap = poses_distance(a, b, group.links, size)
-    return np.nan_to_num(gap, nan=np.inf)
+def _extrapolated(current: Poses, history: tuple[Poses, ...]) -> Poses:
+    """The poses one equal step after ``current``: the quadratic through ``current`` and the two
+    poses of ``history``, or the line through ``current`` and the one; ``current`` itself where
+    an earlier pose is NaN (the trace has just begun there)."""
+    if len(history) == 1:
+        ahead = {k: 2 * v - history[0][k] for k, v in current.items()}
+    else:
+        ahead = {k: 3 * (v - history[0][k]) + history[1][k] for k, v in current.items()}
+    usable = finite_poses(ahead)
+    return ahead if usable.all() else {k: np.where(usable[:, None], v, current[k]) for k, v in ahead.items()}
 
 
 def _refine(group, current: Poses, angle: float, step: float, known_at, listing: bool, size: float):
@@ -426,17 +460,21 @@ def _finite_rows3(rows: Poses) -> np.ndarray:
     return np.all(np.stack([np.all(np.isfinite(v), axis=2) for v in rows.values()]), axis=0)
 
 
-def _pose_distance(a: np.ndarray, b: np.ndarray, size: float) -> np.ndarray:
-    """Distance between poses ``(..., 3)``, m (angles weighted by ``size``, wrapped)."""
+def _squared_gap(a: np.ndarray, b: np.ndarray, size: float) -> np.ndarray:
+    """Squared distance between poses ``(..., 3)``, m^2 (angles weighted by ``size``, wrapped)."""
     d = a - b
-    turn = (d[..., 2] + np.pi) % TWO_PI - np.pi
-    return np.sqrt(d[..., 0] ** 2 + d[..., 1] ** 2 + (size * turn) ** 2)
+    turn = d[..., 2] + np.pi
+    turn %= TWO_PI
+    turn -= np.pi
+    turn *= size
+    x, y = d[..., 0], d[..., 1]
+    return x * x + y * y + turn * turn
 
 
 def poses_distance(a: Poses, b: Poses, links, size: float) -> np.ndarray:
-    """Distance between the poses ``(..., 3)`` of several links, m: the root of the sum of
-    :func:`_pose_distance` squared over ``links``."""
-    return np.sqrt(sum(_pose_distance(a[k], b[k], size) ** 2 for k in links))
+    """Distance between the poses ``(..., 3)`` of several links, m: the root of the sum over
+    ``links`` of each link's squared distance (angles weighted by ``size``, wrapped)."""
+    return np.sqrt(sum(_squared_gap(a[k], b[k], size) for k in links))
 
 
 def same_circuit(group, a: Trace, b: Trace) -> bool:
