@@ -26,7 +26,7 @@ from typing import Callable, NamedTuple
 
 import numpy as np
 
-from assur.generic import TRACE_JUMP, newton, newton_closing
+from assur.generic import TRACE_JUMP, newton_closing
 
 __all__ = ["Trace", "trace_modes", "track_of", "random_start_modes", "poses_distance", "finite_poses", "same_circuit", "STARTS", "SEEDS",
            "REFINEMENTS", "LIMIT_BISECTIONS"]
