@@ -602,6 +602,7 @@ class Kernel:
         self.functions: dict[tuple[int, ...], tuple[Callable, list[int], list[bool]]] = {}
         links = [mech.frame, *structure.inputs, *(k for g in structure.groups for k in g.links)]
         self.links = links
+        self._link_index = {k: i for i, k in enumerate(links)}
         rows: dict[str, tuple[bool, int]] = {}
         for kind in ("pose", "first", "second")[:order + 1]:
             for k in links:
@@ -616,6 +617,8 @@ class Kernel:
                 for c in range(2):
                     rows[f"{kind} {point} {c}"] = (True, len(rows))
         n_groups = len(structure.groups)
+        self.group_rows = len(rows)         # each group's conditioning, sign and scale rows from here
+        self.labels = [repr(g) for g in structure.groups]
         for i in range(n_groups):
             rows[f"conditioning {i}"] = (True, len(rows))
             rows[f"sign {i}"] = (True, len(rows))
@@ -649,6 +652,13 @@ class Kernel:
 
     def branches(self, phi: np.ndarray) -> tuple[int, ...] | None:
         """Each group's branch at every one of ``phi`` (None when one changes among them)."""
+        fixed = self.__dict__.get("_fixed_branches", False)
+        if fixed is False:          # the branches when no plan swaps them (they hold at every phi)
+            plans = assembly_plans(self.mech)
+            fixed = self._fixed_branches = tuple(int(plan.branch) for plan in plans) \
+                if all(plan.mode == "keep" or not plan.swaps.any() for plan in plans) else None
+        if fixed is not None:
+            return fixed
         out = []
         for plan in assembly_plans(self.mech):
             if plan.mode == "keep" or not plan.swaps.any():
@@ -664,7 +674,8 @@ class Kernel:
         """Kinematics at the input coordinates ``phi`` ``(N,)`` (see :func:`run_kernel`), each group
         on its planned branch or on ``branches`` (one per group) when given; ``columns``: the
         geometry's ``(N,)`` inputs of a kernel of variants (:mod:`.kernel_variants`)."""
-        phi = np.atleast_1d(np.asarray(phi, dtype=float))
+        if type(phi) is not np.ndarray or phi.dtype != np.float64 or phi.ndim != 1:
+            phi = np.atleast_1d(np.asarray(phi, dtype=float))
         N = len(phi)
         if not N or phi.ndim != 1:
             return None
@@ -679,13 +690,13 @@ class Kernel:
                 raise ValueError(f"branches must be one of each group's {[g.branches for g in self.structure.groups]}, "
                                  f"got {branches!r}")
         fn, at, is_float = self.function(branches)
-        mech, structure = self.mech, self.structure
+        structure = self.structure
         floats = np.empty((self.n_float, N))
         ints = np.empty((1 + len(structure.groups), N), dtype=int)
         floats[:3] = 0.0                               # the frame's pose (never written)
         inputs = [phi, *columns]
         if len(structure.inputs) > 1:
-            for q in list(input_angles(mech, structure, phi).values())[1:]:
+            for q in list(input_angles(self.mech, structure, phi).values())[1:]:
                 inputs += [np.broadcast_to(np.asarray(v, dtype=float), phi.shape) for v in q]
         whole = getattr(fn, "whole", None)      # the numba kernel (kernel_numba.py): one loop into the rows
         if whole is None or not whole(inputs, floats, ints):
@@ -697,23 +708,45 @@ class Kernel:
                 for start in range(0, N, KERNEL_BLOCK):
                     block = slice(start, min(start + KERNEL_BLOCK, N))
                     fn([v[block] for v in inputs], [v[block] for v in out])
-        result: dict[str, Any] = {}
-        step = 3 * len(self.links)
-        for j, name in enumerate(("poses", "first", "second")):
-            result[name] = None if j > self.order else \
-                {k: floats[j * step + 3 * i:j * step + 3 * i + 3].T for i, k in enumerate(self.links)}
-        start = (self.order + 1) * step
+        step, rows = 3 * len(self.links), self.group_rows
+        result: dict[str, Any] = {name: LinkRows(floats, j * step, self._link_index) if j <= self.order else None
+                                  for j, name in enumerate(("poses", "first", "second"))}
         result["points"] = PointRows(floats, self._point_rows, self.order)
-        start += 2 * (self.order + 1) * len(self.points)
-        groups = structure.groups
-        result["conditioning"] = {repr(g): floats[start + 3 * i] for i, g in enumerate(groups)}
-        result["signs"] = {i: floats[start + 3 * i + 1] for i in range(len(groups))}
-        result["scales"] = {i: floats[start + 3 * i + 2] for i in range(len(groups))}
+        result["conditioning"] = {label: floats[rows + 3 * i] for i, label in enumerate(self.labels)}
+        result["signs"] = {i: floats[rows + 3 * i + 1] for i in range(len(self.labels))}
+        result["scales"] = {i: floats[rows + 3 * i + 2] for i in range(len(self.labels))}
         result["error_bound"] = floats[-1]
         result["status"] = ints[0]
-        result["solved"] = {i: ints[1 + i] for i in range(len(groups))}
+        result["solved"] = {i: ints[1 + i] for i in range(len(self.labels))}
         result["branches"] = branches
         return result
+
+
+class LinkRows(Mapping):
+    """The poses (or analogs of one order) of a kernel's results, link -> ``(N, 3)``, as views of
+    three of its rows each, made when first asked (a call at a few positions does not pay for
+    the links nobody reads)."""
+
+    __slots__ = ("_floats", "_start", "_index", "_views")
+
+    def __init__(self, floats: np.ndarray, start: int, index: dict[str, int]):
+        self._floats, self._start, self._index, self._views = floats, start, index, {}
+
+    def __getitem__(self, link: str) -> np.ndarray:
+        view = self._views.get(link)
+        if view is None:
+            row = self._start + 3 * self._index[link]
+            view = self._views[link] = self._floats[row:row + 3].T
+        return view
+
+    def __contains__(self, link) -> bool:
+        return link in self._index
+
+    def __iter__(self):
+        return iter(self._index)
+
+    def __len__(self) -> int:
+        return len(self._index)
 
 
 class PointRows(Mapping):
@@ -724,8 +757,13 @@ class PointRows(Mapping):
         self._floats, self._rows, self._order = floats, rows, order
 
     def __getitem__(self, key):
-        floats = self._floats
-        return tuple(floats[r:r + 2].T for r in self._rows[key]) + (None,) * (2 - self._order)
+        floats, rows = self._floats, self._rows[key]
+        if self._order == 2:
+            return floats[rows[0]:rows[0] + 2].T, floats[rows[1]:rows[1] + 2].T, floats[rows[2]:rows[2] + 2].T
+        return tuple(floats[r:r + 2].T for r in rows) + (None,) * (2 - self._order)
+
+    def get(self, key, default=None):
+        return self[key] if key in self._rows else default
 
     def __iter__(self):
         return iter(self._rows)

@@ -140,7 +140,7 @@ class Motion:
         """Global position ``(N, 2)`` and first and second analogs of the point ``local``
         (``(2,)``, m) fixed in ``link`` (None beyond the order computed), computed once per motion
         (by the compiled kernel, where it ran, for named points and centres of mass)."""
-        key = ("at", link, (float(local[0]), float(local[1])))
+        key = ("at", link, local if type(local) is tuple else (float(local[0]), float(local[1])))
         got = self._turns.get(key)
         if got is None:
             kernel = self._turns.get("kernel points")     # linkage.kinematics.kernel.PointRows
@@ -154,13 +154,15 @@ class Motion:
         return got
 
     def _owner(self, name: str) -> tuple[str, tuple[float, float]]:
-        """``(link, local point)`` of a named point."""
-        got = self._turns.get(("owner", name))
+        """``(link, local point)`` of a named point (kept on the mechanism)."""
+        owners = self.mechanism.cache.setdefault("point owners", {})
+        got = owners.get(name)
         if got is None:
             link = self.mechanism.point_link(name)
-            if link not in self.poses:
-                raise InputError(f"point '{name}' (link '{link}') was not among the requested outputs")
-            got = self._turns["owner", name] = (link, self.mechanism.links[link].points[name])
+            local = self.mechanism.links[link].points[name]
+            got = owners[name] = (link, (float(local[0]), float(local[1])))
+        if got[0] not in self.poses:
+            raise InputError(f"point '{name}' (link '{got[0]}') was not among the requested outputs")
         return got
 
     def _need(self, order: int) -> None:
@@ -372,8 +374,9 @@ def analyze(
     if on_failure not in ("raise", "mask"):
         raise InputError(f"on_failure must be 'raise' or 'mask', got {on_failure!r}")
     structure = structure_of(mech)
-    phi = np.atleast_1d(np.asarray(phi, dtype=float))
-    if phi.ndim != 1 or not np.all(np.isfinite(phi)):
+    if type(phi) is not np.ndarray or phi.dtype != np.float64 or phi.ndim != 1:
+        phi = np.atleast_1d(np.asarray(phi, dtype=float))
+    if phi.ndim != 1 or not np.isfinite(phi).all():
         raise InputError("phi must be a finite scalar or 1-D array of angles in rad")
     _check_law_domains(mech, phi)
     plans = assembly_plans(mech)
@@ -382,15 +385,19 @@ def analyze(
     run = _kernel_run(mech, phi, order) if outputs is None else None
     if run is None:
         run = run_blocks(mech, structure, plans, list(group_ids), phi, order)
+    status = run.status
+    every_ok = bool((status == OK).all())
+    dphi = phi[1:] - phi[:-1]
+    smallest = float(np.abs(dphi).min()) if len(dphi) else np.inf
     for i in group_ids:
         group = structure.groups[i]
-        _check_continuity(group, run.signs[i], plans[i].branches(phi), run.solved[i], phi, mech.coordinate)
+        branches = plans[i].branches(phi) if run.branches is None else run.branches[i]
+        _check_continuity(group, run.signs[i], branches, None if every_ok else run.solved[i], phi, mech.coordinate)
         _check_change_points(group, plans[i], phi, mech.coordinate)
         if order >= 1:
             _check_jumps(group, plans[i], run.poses, run.first, run.solved[i], phi, mech.coordinate,
-                         None if run.scales is None else run.scales[i])
-    status, bad = run.status, run.status != OK
-    if on_failure == "raise" and bad.any():
+                         None if run.scales is None else run.scales[i], dphi, smallest)
+    if on_failure == "raise" and not every_ok:
         raise _failure(mech, phi, run, structure, plans, list(group_ids))
     poses, first, second = run.poses, run.first, run.second
     omega_arr = eps_arr = None
@@ -415,7 +422,7 @@ def _kernel_run(mech: Mechanism, phi: np.ndarray, order: int) -> _Run | None:
 def _kernel_results(got: dict) -> _Run:
     """A kernel's results (:func:`linkage.kinematics.kernel.run_kernel`) as a :class:`_Run`."""
     return _Run(got["poses"], got["first"], got["second"], got["status"], got["conditioning"],
-                got["error_bound"], got["signs"], got["solved"], got["points"], got["scales"])
+                got["error_bound"], got["signs"], got["solved"], got["points"], got["scales"], got["branches"])
 
 
 def _check_law_domains(mech: Mechanism, phi: np.ndarray) -> None:
@@ -482,6 +489,7 @@ class _Run:
     solved: dict[int, np.ndarray]    # group index -> the group's own status (N,)
     points: Mapping | None = None   # the kernel's: (link, local point) -> position, first, second analogs (N, 2)
     scales: dict[int, np.ndarray] | None = None   # the kernel's: group index -> its length scale (N,), m
+    branches: tuple[int, ...] | None = None   # the kernel's: each group's branch, the same at every position
 
 
 def run_blocks(mech: Mechanism, structure: Structure, plans, group_ids: list[int], phi: np.ndarray,
@@ -609,13 +617,19 @@ def _failure(mech: Mechanism, phi: np.ndarray, run: _Run, structure: Structure, 
     return AssemblyError(message, bad)
 
 
-def _check_continuity(group, sign: np.ndarray, branches: np.ndarray, solved: np.ndarray, phi, coordinate) -> None:
-    """Warn when the group's Jacobian determinant changes sign (relative to the branch in use)
-    between positions: the group passes a singular position between analysed angles."""
-    ok = solved == OK
-    signs = (sign * branches)[ok]
-    if len(signs) and np.any(signs != signs[0]):
-        changed = coordinate.shown(phi[ok][signs != signs[0]])
+def _check_continuity(group, sign: np.ndarray, branches: np.ndarray | int, solved: np.ndarray | None, phi,
+                      coordinate) -> None:
+    """Warn when the group's Jacobian determinant changes sign (relative to the branch in use,
+    ``(N,)`` or one for every position) between the positions where the group's status
+    ``solved`` is OK (None: at every position): the group passes a singular position between
+    analysed angles."""
+    every = solved is None
+    ok = None if every else solved == OK
+    signs = sign if every else sign[ok]
+    if np.ndim(branches):
+        signs = signs * (branches if every else branches[ok])
+    if len(signs) and (signs != signs[0]).any():
+        changed = coordinate.shown((phi if every else phi[ok])[signs != signs[0]])
         warnings.warn(
             f"group {group!r} is in another assembly mode at input {coordinate.kind}s ({coordinate.shown_unit}) "
             f"{np.array2string(changed[:10], precision=4)}: it passes a singular position between "
@@ -657,17 +671,18 @@ def _check_change_points(group, plan, phi, coordinate) -> None:
 JUMP_CHECK_STEP = np.pi / 18
 
 
-def _check_jumps(group, plan, poses, first, status, phi, coordinate, scales: np.ndarray | None = None) -> None:
+def _check_jumps(group, plan, poses, first, status, phi, coordinate, scales: np.ndarray | None,
+                 dphi: np.ndarray, smallest: float) -> None:
     """Warn where a group moves between two analysed angles (at most 10 deg apart) by more than
     its first analogs allow: the displacement of points fixed in its links differs from the
     trapezoid rule on their analogs by more than half of either (a change point or a singular
     position passed between the angles, with no other warning). Checked :data:`BLOCK` steps at
-    a time; ``scales``: the group's length scale per position where the kernel gave it."""
+    a time; ``scales``: the group's length scale per position where the kernel gave it;
+    ``dphi``: the steps between the angles ``phi``, the smallest in magnitude ``smallest``."""
     if len(phi) < 2:
         return
-    dphi = np.diff(phi)
     largest = JUMP_CHECK_STEP * (1.0 if plan.period is not None else float(np.max(group.size)))
-    if np.min(np.abs(dphi)) > largest:        # every step too coarse to tell a jump from a fast motion
+    if smallest > largest:        # every step too coarse to tell a jump from a fast motion
         return
     pairs = (status[:-1] == OK) & (status[1:] == OK) & (np.abs(dphi) <= largest) & (dphi != 0)
     if plan.mode == "keep" and len(plan.change_points):        # passed change points: reported
