@@ -143,7 +143,7 @@ class Motion:
         key = ("at", link, local if type(local) is tuple else (float(local[0]), float(local[1])))
         got = self._turns.get(key)
         if got is None:
-            kernel = self._turns.get("kernel points")     # linkage.kinematics.kernel.PointRows
+            kernel = self._turns.get("kernel points")     # linkage.kinematics.kernel_rows.PointRows
             got = kernel.get(key[1:]) if kernel is not None else None
             if got is None:
                 arm, pose = self.arm(link, local), self.poses[link]
@@ -723,18 +723,19 @@ def _jumps(poses: dict, first: dict, dphi: np.ndarray, scale: float) -> np.ndarr
     """For M + 1 positions: ``(M,)`` whether each step moves more than the trapezoid rule on the
     first analogs allows (see :func:`_check_jumps`). A link's move is the displacement of its
     origin and its turn times ``scale``, the turn taken in (-pi, pi]."""
-    miss2 = moved2 = allowed2 = 0.0
-    for link, pose in poses.items():
-        for k, weight in ((0, 1.0), (1, 1.0), (2, scale)):
-            moved = np.diff(pose[:, k])
-            if k == 2:
-                moved = (moved + np.pi) % (2 * np.pi) - np.pi
-            moved *= weight
-            d = first[link][:, k]
-            allowed = (0.5 * weight) * (d[:-1] + d[1:]) * dphi
-            miss2 = miss2 + (moved - allowed) ** 2
-            moved2 = moved2 + moved * moved
-            allowed2 = allowed2 + allowed * allowed
+    pose = np.stack(list(poses.values()), axis=1)                          # (M + 1, L, 3)
+    rate = np.stack([first[k] for k in poses], axis=1)
+    weight = np.array([1.0, 1.0, scale])
+    moved = pose[1:] - pose[:-1]
+    moved[..., 2] += np.pi
+    moved[..., 2] %= 2 * np.pi
+    moved[..., 2] -= np.pi
+    moved *= weight
+    allowed = (rate[:-1] + rate[1:]) * (0.5 * weight)
+    allowed *= dphi[:, None, None]
+    miss2 = np.square(moved - allowed).sum(axis=(1, 2))
+    moved2 = np.square(moved).sum(axis=(1, 2))
+    allowed2 = np.square(allowed).sum(axis=(1, 2))
     miss = np.sqrt(miss2)
     with np.errstate(invalid="ignore"):
         return (miss > 0.5 * (np.sqrt(moved2) + np.sqrt(allowed2))) & (miss > 1e-9 * scale)
