@@ -723,19 +723,21 @@ def _jumps(poses: dict, first: dict, dphi: np.ndarray, scale: float) -> np.ndarr
     """For M + 1 positions: ``(M,)`` whether each step moves more than the trapezoid rule on the
     first analogs allows (see :func:`_check_jumps`). A link's move is the displacement of its
     origin and its turn times ``scale``, the turn taken in (-pi, pi]."""
-    pose = np.stack(list(poses.values()), axis=1)                          # (M + 1, L, 3)
-    rate = np.stack([first[k] for k in poses], axis=1)
-    weight = np.array([1.0, 1.0, scale])
-    moved = pose[1:] - pose[:-1]
-    moved[..., 2] += np.pi
-    moved[..., 2] %= 2 * np.pi
-    moved[..., 2] -= np.pi
+    pose = np.stack([v.T for v in poses.values()])                         # (L, 3, M + 1)
+    rate = np.stack([first[k].T for k in poses])
+    weight = np.array([1.0, 1.0, scale])[:, None]
+    moved = pose[..., 1:] - pose[..., :-1]
+    moved[:, 2] += np.pi
+    moved[:, 2] %= 2 * np.pi
+    moved[:, 2] -= np.pi
     moved *= weight
-    allowed = (rate[:-1] + rate[1:]) * (0.5 * weight)
-    allowed *= dphi[:, None, None]
-    miss2 = np.square(moved - allowed).sum(axis=(1, 2))
-    moved2 = np.square(moved).sum(axis=(1, 2))
-    allowed2 = np.square(allowed).sum(axis=(1, 2))
+    allowed = rate[..., :-1] + rate[..., 1:]
+    allowed *= 0.5 * weight
+    allowed *= dphi
+    moved, allowed = moved.reshape(-1, len(dphi)), allowed.reshape(-1, len(dphi))     # (3 L, M)
+    miss2 = np.square(moved - allowed).sum(axis=0)
+    moved2 = np.square(moved).sum(axis=0)
+    allowed2 = np.square(allowed).sum(axis=0)
     miss = np.sqrt(miss2)
     with np.errstate(invalid="ignore"):
         return (miss > 0.5 * (np.sqrt(moved2) + np.sqrt(allowed2))) & (miss > 1e-9 * scale)
