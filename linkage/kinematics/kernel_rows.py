@@ -32,6 +32,15 @@ class LinkRows(Mapping):
             view = self._views[link] = self._floats[row:row + 3].T
         return view
 
+    def block(self, links) -> np.ndarray | None:
+        """The rows of ``links`` as one ``(L, 3, N)`` view where their rows are consecutive in
+        this order (a group's links: the kernel writes them so), else None."""
+        first = self._index[links[0]]
+        if any(self._index[k] != first + i for i, k in enumerate(links)):
+            return None
+        row = self._start + 3 * first
+        return self._floats[row:row + 3 * len(links)].reshape(len(links), 3, -1)
+
     def __contains__(self, link) -> bool:
         return link in self._index
 

@@ -395,7 +395,8 @@ def analyze(
         _check_continuity(group, run.signs[i], branches, None if every_ok else run.solved[i], phi, mech.coordinate)
         _check_change_points(group, plans[i], phi, mech.coordinate)
         if order >= 1:
-            _check_jumps(group, plans[i], run.poses, run.first, run.solved[i], phi, mech.coordinate,
+            _check_jumps(group, plans[i], run.poses, run.first, None if every_ok else run.solved[i], phi,
+                         mech.coordinate,
                          None if run.scales is None else run.scales[i], dphi, smallest)
     if on_failure == "raise" and not every_ok:
         raise _failure(mech, phi, run, structure, plans, list(group_ids))
@@ -677,22 +678,29 @@ def _check_jumps(group, plan, poses, first, status, phi, coordinate, scales: np.
     its first analogs allow: the displacement of points fixed in its links differs from the
     trapezoid rule on their analogs by more than half of either (a change point or a singular
     position passed between the angles, with no other warning). Checked :data:`BLOCK` steps at
-    a time; ``scales``: the group's length scale per position where the kernel gave it;
-    ``dphi``: the steps between the angles ``phi``, the smallest in magnitude ``smallest``."""
+    a time; ``status``: the group's own status (None: OK at every position); ``scales``: the
+    group's length scale per position where the kernel gave it; ``dphi``: the steps between the
+    angles ``phi``, the smallest in magnitude ``smallest``."""
     if len(phi) < 2:
         return
     largest = JUMP_CHECK_STEP * (1.0 if plan.period is not None else float(np.max(group.size)))
     if smallest > largest:        # every step too coarse to tell a jump from a fast motion
         return
-    pairs = (status[:-1] == OK) & (status[1:] == OK) & (np.abs(dphi) <= largest) & (dphi != 0)
+    pairs = (np.abs(dphi) <= largest) & (dphi != 0)
+    if status is not None:
+        pairs &= (status[:-1] == OK) & (status[1:] == OK)
     if plan.mode == "keep" and len(plan.change_points):        # passed change points: reported
         pairs &= ~plan.crossed(phi).any(axis=0)
     if not pairs.any():
         return
-    sample = np.flatnonzero(status == OK)
-    sample = sample[:: max(1, len(sample) // 4096)]
-    scale = float(np.median(group.scale({k: v[sample] for k, v in poses.items()}) if scales is None
-                            else scales[sample]))
+    if status is None:
+        sample = slice(None, None, max(1, len(phi) // 4096))
+    else:
+        sample = np.flatnonzero(status == OK)
+        sample = sample[:: max(1, len(sample) // 4096)]
+    sizes = group.scale({k: v[sample] for k, v in poses.items()}) if scales is None else scales[sample]
+    middle = len(sizes) // 2            # the upper median: one partition, not a sort
+    scale = float(np.partition(sizes, middle)[middle])
     bad = jump_steps(group, poses, first, pairs, dphi, scale)
     if bad.any():
         k = np.flatnonzero(bad)
@@ -710,21 +718,27 @@ def jump_steps(group, poses: dict, first: dict, pairs: np.ndarray, dphi: np.ndar
     steps ``dphi``) where a link of ``group`` moves more than its analogs allow (see
     :func:`_check_jumps`; ``scale``, m, weighs the links' turns). :data:`BLOCK` steps at a time."""
     bad = np.zeros(len(dphi), bool)
+    pose, rate = _link_block(poses, group.links), _link_block(first, group.links)
     for start in range(0, len(dphi), BLOCK):
         steps = slice(start, min(start + BLOCK, len(dphi)))
         if pairs[steps].any():
             ends = slice(steps.start, steps.stop + 1)
-            bad[steps] = _jumps({k: poses[k][ends] for k in group.links}, {k: first[k][ends] for k in group.links},
-                                dphi[steps], scale) & pairs[steps]
+            bad[steps] = _jumps(pose[..., ends], rate[..., ends], dphi[steps], scale) & pairs[steps]
     return bad
 
 
-def _jumps(poses: dict, first: dict, dphi: np.ndarray, scale: float) -> np.ndarray:
+def _link_block(values, links) -> np.ndarray:
+    """``(L, 3, N)``: the ``(N, 3)`` values of ``links`` as rows (a view of a kernel's rows where
+    they are consecutive there)."""
+    block = values.block(links) if hasattr(values, "block") else None
+    return np.stack([values[k].T for k in links]) if block is None else block
+
+
+def _jumps(pose: np.ndarray, rate: np.ndarray, dphi: np.ndarray, scale: float) -> np.ndarray:
     """For M + 1 positions: ``(M,)`` whether each step moves more than the trapezoid rule on the
-    first analogs allows (see :func:`_check_jumps`). A link's move is the displacement of its
-    origin and its turn times ``scale``, the turn taken in (-pi, pi]."""
-    pose = np.stack([v.T for v in poses.values()])                         # (L, 3, M + 1)
-    rate = np.stack([first[k].T for k in poses])
+    first analogs allows (see :func:`_check_jumps`), from the poses ``pose`` and first analogs
+    ``rate`` of L links, ``(L, 3, M + 1)`` each. A link's move is the displacement of its origin
+    and its turn times ``scale``, the turn taken in (-pi, pi]."""
     weight = np.array([1.0, 1.0, scale])[:, None]
     moved = pose[..., 1:] - pose[..., :-1]
     moved[:, 2] += np.pi
