@@ -59,10 +59,9 @@ class PointRows(Mapping):
         self._floats, self._rows, self._order = floats, rows, order
 
     def __getitem__(self, key):
-        floats, rows = self._floats, self._rows[key]
-        if self._order == 2:
-            return floats[rows[0]:rows[0] + 2].T, floats[rows[1]:rows[1] + 2].T, floats[rows[2]:rows[2] + 2].T
-        return tuple(floats[r:r + 2].T for r in rows) + (None,) * (2 - self._order)
+        floats, rows, order = self._floats, self._rows[key], self._order
+        return (floats[rows[0]:rows[0] + 2].T, floats[rows[1]:rows[1] + 2].T if order >= 1 else None,
+                floats[rows[2]:rows[2] + 2].T if order == 2 else None)
 
     def get(self, key, default=None):
         return self[key] if key in self._rows else default

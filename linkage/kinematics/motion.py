@@ -387,8 +387,9 @@ def analyze(
         run = run_blocks(mech, structure, plans, list(group_ids), phi, order)
     status = run.status
     every_ok = bool((status == OK).all())
-    dphi = phi[1:] - phi[:-1]
-    smallest = float(np.abs(dphi).min()) if len(dphi) else np.inf
+    if order >= 1:          # the steps, for the jump check
+        dphi = phi[1:] - phi[:-1]
+        smallest = float(np.abs(dphi).min()) if len(dphi) else np.inf
     for i in group_ids:
         group = structure.groups[i]
         branches = plans[i].branches(phi) if run.branches is None else run.branches[i]
