@@ -150,8 +150,7 @@ def _stack(layout, group: Group, poses: Poses, start: Poses) -> np.ndarray:
     """The pose stack ``(N, L + K, 3)`` of :meth:`assur.fused.FusedLayout.evaluate`: the start
     poses of the group's links, then the known links' poses (broadcast to N)."""
     links = group.links
-    first = np.asarray(start[links[0]], float)
-    N = len(first)
+    N = len(start[links[0]])
     stack = np.empty((N, len(layout.order), 3))
     for i, k in enumerate(layout.order):
         stack[:, i] = start[k] if i < len(links) else poses[k]
@@ -173,17 +172,16 @@ def _iterate(layout, group: Group, stack: np.ndarray, steps: int, closure: float
     limit, unit, positive = layout.damping(group.size, N)
     converged = np.zeros(N, bool)
     gap = np.full(N, np.inf) if closure is not None else None
-    weight = None
+    weight = None           # (N, m): 1, the size on the prismatic angle rows (the closure is in m)
     if closure is not None and len(layout.angle_rows):
-        weight = np.ones((1, layout.rows)) if np.ndim(group.size) == 0 else np.ones((N, layout.rows))
+        weight = np.ones((N, layout.rows))
         weight[:, layout.angle_rows] = np.reshape(group.size, (-1, 1))
     rows = np.flatnonzero(np.isfinite(q).all(axis=1))       # the positions still iterated
     for _ in range(steps if len(rows) else 0):
         every = len(rows) == N
         residual, full = layout.evaluate(stack if every else stack[rows])
         if closure is not None:
-            norm = np.abs(residual if weight is None else residual * (weight if len(weight) == 1 else weight[rows])
-                          ).max(axis=1)
+            norm = np.abs(residual if weight is None else residual * weight[rows]).max(axis=1)
             close = norm <= closure
             if close.any():
                 gap[rows[close]] = norm[close]
@@ -229,7 +227,7 @@ def _iterate(layout, group: Group, stack: np.ndarray, steps: int, closure: float
         if closure is not None and len(rows):           # out of steps: how well the last poses close
             residual, _ = layout.evaluate(stack[rows], jacobian=False)
             if weight is not None:
-                residual = residual * (weight if len(weight) == 1 else weight[rows])
+                residual = residual * weight[rows]
             with np.errstate(invalid="ignore"):
                 gap[rows] = np.nan_to_num(np.abs(residual).max(axis=1), nan=np.inf)
     return converged, gap

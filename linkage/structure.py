@@ -238,7 +238,9 @@ def _group_by_masks(unknown: list[str], known, joints, used) -> tuple[str, ...] 
             continue
         inside = [np.ones(1 << m, bool) if k in known else (masks & bit[k]) != 0 for k in (j.a, j.b)]
         rows += j.rows * (inside[0] & inside[1])
-    size = np.bitwise_count(masks.astype(np.uint64)).astype(np.int64)
+    size = np.zeros(1 << m, dtype=np.int64)         # links in each subset (numpy 1.x has no bitwise_count)
+    for i in range(m):
+        size += (masks >> i) & 1
     over = (rows >= 3 * size) & (size > 0)          # no group may hold one of these as a proper part
     within = over.copy()                            # over[T] for some T within S (S itself too)
     for i in range(m):

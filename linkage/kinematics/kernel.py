@@ -653,13 +653,6 @@ class Kernel:
 
     def branches(self, phi: np.ndarray) -> tuple[int, ...] | None:
         """Each group's branch at every one of ``phi`` (None when one changes among them)."""
-        fixed = self.__dict__.get("_fixed_branches", False)
-        if fixed is False:          # the branches when no plan swaps them (they hold at every phi)
-            plans = assembly_plans(self.mech)
-            fixed = self._fixed_branches = tuple(int(plan.branch) for plan in plans) \
-                if all(plan.mode == "keep" or not plan.swaps.any() for plan in plans) else None
-        if fixed is not None:
-            return fixed
         out = []
         for plan in assembly_plans(self.mech):
             if plan.mode == "keep" or not plan.swaps.any():

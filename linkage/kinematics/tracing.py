@@ -302,6 +302,7 @@ def _advance(group, current: Poses, known: Poses, options, size: float, history:
     trace). ``steps``: Newton steps at most (default :data:`assur.generic.NEWTON_STEPS`)."""
     links = group.links
     C = len(current[links[0]])
+    reached, ok = {k: np.full((C, 3), np.nan) for k in links}, np.zeros(C, bool)
     if options is not None:
         candidates, valid = options
         gap2 = sum(_squared_gap(candidates[k][0][None], current[k][:, None], size) for k in links)
@@ -309,25 +310,15 @@ def _advance(group, current: Poses, known: Poses, options, size: float, history:
         best = np.argmin(gap2, axis=1)
         reached = {k: candidates[k][0][best] for k in links}
         ok = poses_distance(reached, current, links, size) <= TRACE_JUMP * size      # False where NaN
-        rows = np.flatnonzero(~ok & finite_poses(current))
-    else:
-        reached, ok = None, np.zeros(C, bool)
-        rows = np.flatnonzero(finite_poses(current))
+    rows = np.flatnonzero(~ok & finite_poses(current))
     if len(rows):
         start = _extrapolated(current, history) if history else current
-        every = len(rows) == C
-        if not every:
+        if len(rows) < C:
             start, current = ({k: v[rows] for k, v in start.items()}, {k: v[rows] for k, v in current.items()})
         solved, gap = newton_closing(group, known, start, TRACE_CLOSURE * size, steps)
         ok[rows] = (gap <= 1e-9 * size) & (poses_distance(solved, current, links, size) <= TRACE_JUMP * size)
-        if reached is None and every:
-            return solved, ok
-        if reached is None:
-            reached = {k: np.full((C, 3), np.nan) for k in links}
         for k in links:
             reached[k][rows] = solved[k]
-    elif reached is None:
-        reached = {k: np.full((C, 3), np.nan) for k in links}
     return reached, ok
 
 
